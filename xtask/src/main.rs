@@ -3,7 +3,7 @@
 //! Each command lives in its own module; this file only dispatches and reports errors.
 
 mod args;
-mod simulate;
+
 
 use std::process::ExitCode;
 
@@ -14,12 +14,12 @@ commands:
 
 fn main() -> ExitCode {
     let raw: Vec<String> = std::env::args().skip(1).collect();
-    let Some((command, rest)) = raw.split_first() else {
+    let Some((command, _rest)) = raw.split_first() else {
         eprintln!("{USAGE}");
         return ExitCode::from(2);
     };
     let result = match command.as_str() {
-        "simulate" => simulate::run(rest),
+
         "help" | "--help" | "-h" => {
             println!("{USAGE}");
             Ok(())

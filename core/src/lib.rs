@@ -1,0 +1,8 @@
+//! javari-core: every equation and solver of the Javari instrument, free of any plugin framework.
+//!
+//! Tanpura voice (van Walstijn & Chatziioannou, ISMA 2014; `shared/notes/tanpura-model.md`) and
+//! bowed voice (McIntyre–Schumacher–Woodhouse, Woodhouse 1993; `shared/notes/bowed-model.md`).
+//! SI units throughout.
+
+pub mod bowed;
+pub mod stability;
