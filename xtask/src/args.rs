@@ -77,9 +77,9 @@ impl Args {
             None => Ok(default),
             Some(text) => {
                 let range = format!("a number from {min} to {max}");
-                let value: T = text.parse().map_err(|_| {
-                    ArgError(format!("option `--{name}`: `{text}` is not {range}"))
-                })?;
+                let value: T = text
+                    .parse()
+                    .map_err(|_| ArgError(format!("option `--{name}`: `{text}` is not {range}")))?;
                 // `!(a <= b)` rather than `a > b` so that a NaN is rejected too.
                 if !(min <= value && value <= max) {
                     return Err(ArgError(format!(

@@ -4,7 +4,6 @@
 
 mod args;
 
-
 use std::process::ExitCode;
 
 const USAGE: &str = "usage: cargo xtask <command> [options]
@@ -19,7 +18,6 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     };
     let result = match command.as_str() {
-
         "help" | "--help" | "-h" => {
             println!("{USAGE}");
             Ok(())
