@@ -17,7 +17,7 @@ fn main() -> ExitCode {
         eprintln!("{USAGE}");
         return ExitCode::from(2);
     };
-    let result = match command.as_str() {
+    let result: Result<(), Box<dyn std::error::Error>> = match command.as_str() {
         "help" | "--help" | "-h" => {
             println!("{USAGE}");
             Ok(())
