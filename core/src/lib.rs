@@ -6,3 +6,13 @@
 
 pub mod bowed;
 pub mod stability;
+
+pub mod banded;
+pub mod barrier_grid;
+pub mod contact;
+pub mod decimator;
+pub mod excitation;
+pub mod newton;
+pub mod string_operator;
+pub mod tanpura;
+pub mod tanpura_string;

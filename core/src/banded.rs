@@ -1,0 +1,266 @@
+//! Symmetric banded matrices and their LDLᵀ factorisation, allocation-free after construction.
+//!
+//! The string operator of the tanpura scheme (seed 000, eq. 14–15) is pentadiagonal, and each
+//! contact term `I* C I` of the Newton Jacobian (eq. 24) adds a band of half-width 3 from the
+//! four-point Lagrange stencil. The Jacobian stays symmetric positive definite (C ≥ 0), so a
+//! square-root-free LDLᵀ factorisation without pivoting is exact and stable. No crate offers an
+//! allocation-free banded factorisation, hence this hand-written one (`design.md`).
+
+/// A symmetric `size × size` matrix whose entries vanish more than `half_bandwidth` off the
+/// diagonal. Storage: `band[row * (w + 1) + k] = A[row][row − k]` for `k = 0..=w`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SymmetricBanded {
+    size: usize,
+    half_bandwidth: usize,
+    band: Vec<f64>,
+}
+
+impl SymmetricBanded {
+    /// A zero matrix. Allocates; everything else is allocation-free.
+    pub fn zeros(size: usize, half_bandwidth: usize) -> Self {
+        Self {
+            size,
+            half_bandwidth,
+            band: vec![0.0; size * (half_bandwidth + 1)],
+        }
+    }
+
+    pub fn size(&self) -> usize {
+        self.size
+    }
+
+    pub fn half_bandwidth(&self) -> usize {
+        self.half_bandwidth
+    }
+
+    fn index(&self, row: usize, column: usize) -> usize {
+        let (row, column) = if row >= column {
+            (row, column)
+        } else {
+            (column, row)
+        };
+        let offset = row - column;
+        debug_assert!(offset <= self.half_bandwidth, "entry outside the band");
+        row * (self.half_bandwidth + 1) + offset
+    }
+
+    /// Sets every entry to zero.
+    pub fn clear(&mut self) {
+        self.band.fill(0.0);
+    }
+
+    /// `A[row][column]` (zero outside the band).
+    pub fn get(&self, row: usize, column: usize) -> f64 {
+        if row.abs_diff(column) > self.half_bandwidth {
+            0.0
+        } else {
+            self.band[self.index(row, column)]
+        }
+    }
+
+    /// Sets `A[row][column]` and, by symmetry, `A[column][row]`.
+    pub fn set(&mut self, row: usize, column: usize, value: f64) {
+        let index = self.index(row, column);
+        self.band[index] = value;
+    }
+
+    /// Adds to `A[row][column]` (and its mirror): one call per symmetric pair, not two.
+    pub fn add(&mut self, row: usize, column: usize, value: f64) {
+        let index = self.index(row, column);
+        self.band[index] += value;
+    }
+
+    /// Copies another matrix of the same size whose band is no wider than this one's.
+    pub fn copy_from(&mut self, other: &SymmetricBanded) {
+        debug_assert_eq!(self.size, other.size);
+        debug_assert!(other.half_bandwidth <= self.half_bandwidth);
+        if other.half_bandwidth == self.half_bandwidth {
+            self.band.copy_from_slice(&other.band);
+            return;
+        }
+        self.band.fill(0.0);
+        let width = self.half_bandwidth + 1;
+        let other_width = other.half_bandwidth + 1;
+        for row in 0..self.size {
+            self.band[row * width..row * width + other_width]
+                .copy_from_slice(&other.band[row * other_width..(row + 1) * other_width]);
+        }
+    }
+
+    /// `output = A · input`.
+    pub fn multiply(&self, input: &[f64], output: &mut [f64]) {
+        let width = self.half_bandwidth + 1;
+        output[..self.size].fill(0.0);
+        for row in 0..self.size {
+            let entries = &self.band[row * width..(row + 1) * width];
+            output[row] += entries[0] * input[row];
+            for (offset, &entry) in entries.iter().enumerate().skip(1) {
+                if offset > row {
+                    break;
+                }
+                let column = row - offset;
+                output[row] += entry * input[column];
+                output[column] += entry * input[row];
+            }
+        }
+    }
+}
+
+/// The factors `L` (unit lower triangular, banded) and `D` (diagonal) of `A = L D Lᵀ`, stored in
+/// place of the band: `band[row][0] = D[row]`, `band[row][k] = L[row][row − k]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BandedLdlt {
+    factors: SymmetricBanded,
+}
+
+/// The matrix handed to [`BandedLdlt::factorise`] was not positive definite.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NotPositiveDefinite {
+    pub row: usize,
+}
+
+impl BandedLdlt {
+    /// Room for factorising matrices of this shape. Allocates.
+    pub fn with_shape(size: usize, half_bandwidth: usize) -> Self {
+        Self {
+            factors: SymmetricBanded::zeros(size, half_bandwidth),
+        }
+    }
+
+    /// Factorises `matrix` into the preallocated storage: O(size · w²) operations, no allocation.
+    pub fn factorise(&mut self, matrix: &SymmetricBanded) -> Result<(), NotPositiveDefinite> {
+        self.factors.copy_from(matrix);
+        let size = self.factors.size;
+        let w = self.factors.half_bandwidth;
+        let width = w + 1;
+        let band = &mut self.factors.band;
+        for row in 0..size {
+            // L[row][col] · D[col] = A[row][col] − Σ_{k<col} L[row][k] D[k] L[col][k]
+            let first = row.saturating_sub(w);
+            for column in first..row {
+                let mut value = band[row * width + (row - column)];
+                let shared_first = first.max(column.saturating_sub(w));
+                for k in shared_first..column {
+                    value -= band[row * width + (row - k)]
+                        * band[k * width]
+                        * band[column * width + (column - k)];
+                }
+                band[row * width + (row - column)] = value / band[column * width];
+            }
+            let mut diagonal = band[row * width];
+            for k in first..row {
+                let l = band[row * width + (row - k)];
+                diagonal -= l * l * band[k * width];
+            }
+            if diagonal.is_nan() || diagonal <= 0.0 {
+                return Err(NotPositiveDefinite { row });
+            }
+            band[row * width] = diagonal;
+        }
+        Ok(())
+    }
+
+    /// Solves `A x = rhs` in place (`solution` holds `rhs` on entry).
+    pub fn solve_in_place(&self, solution: &mut [f64]) {
+        let size = self.factors.size;
+        let w = self.factors.half_bandwidth;
+        let width = w + 1;
+        let band = &self.factors.band;
+        // Forward: L z = b.
+        for row in 0..size {
+            let first = row.saturating_sub(w);
+            let mut value = solution[row];
+            for k in first..row {
+                value -= band[row * width + (row - k)] * solution[k];
+            }
+            solution[row] = value;
+        }
+        // Diagonal: D u = z.
+        for row in 0..size {
+            solution[row] /= band[row * width];
+        }
+        // Backward: Lᵀ x = u.
+        for row in (0..size).rev() {
+            let last = (row + w).min(size - 1);
+            let mut value = solution[row];
+            for k in row + 1..=last {
+                value -= band[k * width + (k - row)] * solution[k];
+            }
+            solution[row] = value;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A diagonally dominant symmetric test matrix with entries that differ everywhere.
+    fn test_matrix(size: usize, w: usize) -> SymmetricBanded {
+        let mut matrix = SymmetricBanded::zeros(size, w);
+        for row in 0..size {
+            matrix.set(row, row, 10.0 + row as f64 * 0.1);
+            for offset in 1..=w.min(row) {
+                matrix.set(
+                    row,
+                    row - offset,
+                    1.0 / (1.0 + offset as f64 + 0.3 * row as f64),
+                );
+            }
+        }
+        matrix
+    }
+
+    #[test]
+    fn solves_against_a_known_solution() {
+        for w in 1..=4 {
+            let size = 23;
+            let matrix = test_matrix(size, w);
+            let exact: Vec<f64> = (0..size).map(|i| (i as f64 * 0.7).sin() + 0.1).collect();
+            let mut rhs = vec![0.0; size];
+            matrix.multiply(&exact, &mut rhs);
+            let mut ldlt = BandedLdlt::with_shape(size, w);
+            ldlt.factorise(&matrix).unwrap();
+            ldlt.solve_in_place(&mut rhs);
+            for (x, e) in rhs.iter().zip(&exact) {
+                assert!((x - e).abs() < 1e-13, "w={w}: {x} vs {e}");
+            }
+        }
+    }
+
+    #[test]
+    fn multiply_matches_dense_product_by_hand() {
+        // [[2,1,0],[1,3,4],[0,4,5]] · [1,2,3] = [4, 19, 23]
+        let mut matrix = SymmetricBanded::zeros(3, 1);
+        matrix.set(0, 0, 2.0);
+        matrix.set(1, 1, 3.0);
+        matrix.set(2, 2, 5.0);
+        matrix.set(1, 0, 1.0);
+        matrix.set(2, 1, 4.0);
+        let mut output = [0.0; 3];
+        matrix.multiply(&[1.0, 2.0, 3.0], &mut output);
+        assert_eq!(output, [4.0, 19.0, 23.0]);
+    }
+
+    #[test]
+    fn indefinite_matrix_is_reported_not_factorised() {
+        let mut matrix = SymmetricBanded::zeros(2, 1);
+        matrix.set(0, 0, 1.0);
+        matrix.set(1, 1, 1.0);
+        matrix.set(1, 0, 2.0);
+        let mut ldlt = BandedLdlt::with_shape(2, 1);
+        assert_eq!(ldlt.factorise(&matrix), Err(NotPositiveDefinite { row: 1 }));
+    }
+
+    #[test]
+    fn narrow_matrix_copies_into_wider_band() {
+        let narrow = test_matrix(9, 2);
+        let mut wide = SymmetricBanded::zeros(9, 3);
+        wide.copy_from(&narrow);
+        for row in 0..9 {
+            for column in 0..9 {
+                assert_eq!(wide.get(row, column), narrow.get(row, column));
+            }
+        }
+    }
+}

@@ -1,0 +1,390 @@
+//! A barrier (bridge, thread or finger) on its own fine grid, tied to the string grid by
+//! third-order Lagrange interpolation.
+//!
+//! Source: seed 000, eq. 17–25. Each barrier point `x_i` (spacing Δx_b) has a height
+//! `y_barrier(x_i)`; the string's displacement and step there are `ỹ = I y` and `s̃ = I s`,
+//! with `I` the four-point (cubic) Lagrange interpolation from the string nodes (eq. 17, 23).
+//! Forces go back with the scaled transpose `I* = (Δx_b/Δx) Iᵀ` (eq. 20–21), which makes the
+//! work done on the string, `Δx (I* f̃)·s = Δx_b f̃·s̃`, equal to the work done by the barrier:
+//! the energy balance stays exact. The barrier's Jacobian contribution is `I* C I` (eq. 24) with
+//! `C = diag(c_i)`, `c_i = −∂f̃_i/∂s̃_i ≥ 0` (eq. 25), symmetric and positive semi-definite.
+//!
+//! Stencils that reach the fixed end nodes read their boundary values (the lowered support);
+//! forces and Jacobian entries at fixed nodes are dropped, since those nodes do not move and
+//! their step is zero, which costs nothing in the energy balance.
+
+use crate::banded::SymmetricBanded;
+use crate::contact::{potential_density, HuntCrossley};
+
+/// One barrier: its points, shape, contact law and per-step work arrays.
+#[derive(Debug, Clone)]
+pub struct BarrierGrid {
+    spacing_m: f64,
+    count: usize,
+    /// N of the string grid (nodes 0 and N are fixed).
+    string_intervals: usize,
+    /// Δx_b/Δx, the factor of the scaled transpose (eq. 21).
+    transpose_scale: f64,
+    stiffness_n_m2: f64,
+    damping_s_m: f64,
+    law: HuntCrossley,
+    positions_m: Vec<f64>,
+    heights_m: Vec<f64>,
+    stencil_first_node: Vec<usize>,
+    stencil_weights: Vec<[f64; 4]>,
+    /// a_i = y_barrier − ỹ^n: positive means the string penetrates the barrier.
+    gaps_m: Vec<f64>,
+    steps_m: Vec<f64>,
+    forces: Vec<f64>,
+    jacobian: Vec<f64>,
+    squared_gap_changes: Vec<f64>,
+}
+
+/// Cubic Lagrange weights on the nodes `first..first + 4` for the point `x` (in units of Δx).
+/// The stencil is the two nodes on each side where possible, shifted inwards at the ends.
+pub fn lagrange_stencil(position_in_intervals: f64, intervals: usize) -> (usize, [f64; 4]) {
+    let below = position_in_intervals.floor() as isize;
+    let first = (below - 1).clamp(0, intervals as isize - 3) as usize;
+    let t = position_in_intervals - first as f64;
+    let mut weights = [0.0; 4];
+    for (j, weight) in weights.iter_mut().enumerate() {
+        let mut value = 1.0;
+        for k in 0..4 {
+            if k != j {
+                value *= (t - k as f64) / (j as f64 - k as f64);
+            }
+        }
+        *weight = value;
+    }
+    (first, weights)
+}
+
+impl BarrierGrid {
+    /// Room for up to `capacity` points on a string of `string_intervals` intervals. Allocates.
+    pub fn with_capacity(capacity: usize, string_intervals: usize) -> Self {
+        Self {
+            spacing_m: 0.0,
+            count: 0,
+            string_intervals,
+            transpose_scale: 0.0,
+            stiffness_n_m2: 0.0,
+            damping_s_m: 0.0,
+            law: HuntCrossley { xi: 0.0, psi: 0.0 },
+            positions_m: vec![0.0; capacity],
+            heights_m: vec![0.0; capacity],
+            stencil_first_node: vec![0; capacity],
+            stencil_weights: vec![[0.0; 4]; capacity],
+            gaps_m: vec![0.0; capacity],
+            steps_m: vec![0.0; capacity],
+            forces: vec![0.0; capacity],
+            jacobian: vec![0.0; capacity],
+            squared_gap_changes: vec![0.0; capacity],
+        }
+    }
+
+    pub fn capacity(&self) -> usize {
+        self.positions_m.len()
+    }
+
+    /// Places `count` points from `first_m` with spacing `spacing_m` (clamped to capacity) and
+    /// samples the barrier shape `height_at(x)`. Allocation-free.
+    pub fn place(
+        &mut self,
+        first_m: f64,
+        spacing_m: f64,
+        count: usize,
+        string_spacing_m: f64,
+        height_at: impl Fn(f64) -> f64,
+    ) {
+        let count = count.min(self.capacity());
+        self.count = count;
+        self.spacing_m = spacing_m;
+        self.transpose_scale = spacing_m / string_spacing_m;
+        for i in 0..count {
+            let x = first_m + i as f64 * spacing_m;
+            self.positions_m[i] = x;
+            self.heights_m[i] = height_at(x);
+            let (first, weights) = lagrange_stencil(x / string_spacing_m, self.string_intervals);
+            self.stencil_first_node[i] = first;
+            self.stencil_weights[i] = weights;
+        }
+    }
+
+    /// Moves the whole barrier up by `offset_m` (a rigid finger rising). Allocation-free.
+    pub fn raise(&mut self, offset_m: f64) {
+        for height in &mut self.heights_m[..self.count] {
+            *height += offset_m;
+        }
+    }
+
+    /// Sets the contact law (k in N/m², r in s/m) for a scheme of step Δt and density ρA.
+    pub fn set_law(
+        &mut self,
+        stiffness_n_m2: f64,
+        damping_s_m: f64,
+        time_step_s: f64,
+        linear_density_kg_m: f64,
+    ) {
+        self.stiffness_n_m2 = stiffness_n_m2;
+        self.damping_s_m = damping_s_m;
+        self.law = HuntCrossley::scaled(
+            stiffness_n_m2,
+            damping_s_m,
+            time_step_s,
+            linear_density_kg_m,
+        );
+    }
+
+    /// Whether this barrier can exert any force (points placed and k > 0).
+    pub fn is_active(&self) -> bool {
+        self.count > 0 && self.stiffness_n_m2 > 0.0
+    }
+
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    pub fn stiffness_n_m2(&self) -> f64 {
+        self.stiffness_n_m2
+    }
+
+    pub fn positions_m(&self) -> &[f64] {
+        &self.positions_m[..self.count]
+    }
+
+    pub fn heights_m(&self) -> &[f64] {
+        &self.heights_m[..self.count]
+    }
+
+    /// `(I v)_i`: the full-node vector `values` interpolated at point `i`.
+    #[inline]
+    pub fn interpolate(&self, values: &[f64], i: usize) -> f64 {
+        let first = self.stencil_first_node[i];
+        let w = &self.stencil_weights[i];
+        w[0] * values[first]
+            + w[1] * values[first + 1]
+            + w[2] * values[first + 2]
+            + w[3] * values[first + 3]
+    }
+
+    /// Records the gaps `a_i = y_barrier(x_i) − ỹ_i` for the displacement before the step.
+    pub fn begin_step(&mut self, displacement: &[f64]) {
+        for i in 0..self.count {
+            self.gaps_m[i] = self.heights_m[i] - self.interpolate(displacement, i);
+        }
+    }
+
+    /// Whether any point can be in contact during the step `step` (full-node vector): a point
+    /// exerts a force only if its gap is positive before or after the step.
+    pub fn touches_during(&self, step: &[f64]) -> bool {
+        (0..self.count).any(|i| {
+            let gap = self.gaps_m[i];
+            gap > 0.0 || gap - self.interpolate(step, i) > 0.0
+        })
+    }
+
+    /// Evaluates the mid-point forces and Jacobian entries for the step `step`.
+    pub fn evaluate(&mut self, step: &[f64]) {
+        for i in 0..self.count {
+            let point_step = self.interpolate(step, i);
+            let contact = self.law.midpoint_force(self.gaps_m[i], point_step);
+            self.steps_m[i] = point_step;
+            self.forces[i] = contact.force;
+            self.jacobian[i] = contact.stiffness;
+            self.squared_gap_changes[i] = contact.squared_gap_change;
+        }
+    }
+
+    /// Adds `I* f̃` (scaled forces on the string nodes) into the full-node vector `output`.
+    pub fn spread_forces(&self, output: &mut [f64]) {
+        let last_free = self.string_intervals - 1;
+        for i in 0..self.count {
+            let force = self.transpose_scale * self.forces[i];
+            if force == 0.0 {
+                continue;
+            }
+            let first = self.stencil_first_node[i];
+            for (j, weight) in self.stencil_weights[i].iter().enumerate() {
+                let node = first + j;
+                if (1..=last_free).contains(&node) {
+                    output[node] += weight * force;
+                }
+            }
+        }
+    }
+
+    /// Adds `I* C I` into `jacobian`, whose row r is string node r + 1.
+    pub fn add_jacobian(&self, jacobian: &mut SymmetricBanded) {
+        let last_free = self.string_intervals - 1;
+        for i in 0..self.count {
+            let stiffness = self.transpose_scale * self.jacobian[i];
+            if stiffness == 0.0 {
+                continue;
+            }
+            let first = self.stencil_first_node[i];
+            let w = &self.stencil_weights[i];
+            for j in 0..4 {
+                let row_node = first + j;
+                if !(1..=last_free).contains(&row_node) {
+                    continue;
+                }
+                for k in 0..=j {
+                    let column_node = first + k;
+                    if !(1..=last_free).contains(&column_node) {
+                        continue;
+                    }
+                    jacobian.add(row_node - 1, column_node - 1, stiffness * w[j] * w[k]);
+                }
+            }
+        }
+    }
+
+    /// Whether the last [`evaluate`](Self::evaluate) found any point exerting a force.
+    pub fn has_force(&self) -> bool {
+        self.forces[..self.count].iter().any(|&f| f != 0.0)
+    }
+
+    /// The barrier's potential energy `Δx_b Σ k/2 ⌊a_i⌋²` (J) for a displacement.
+    pub fn potential_energy_j(&self, displacement: &[f64]) -> f64 {
+        let sum: f64 = (0..self.count)
+            .map(|i| {
+                let gap = self.heights_m[i] - self.interpolate(displacement, i);
+                potential_density(self.stiffness_n_m2, gap)
+            })
+            .sum();
+        self.spacing_m * sum
+    }
+
+    /// Energy (J) dissipated by the contact damping r over the last evaluated step:
+    /// `Δx_b Σ −(r/Δt)(k/2) Φ_i s̃_i ≥ 0`.
+    pub fn step_loss_j(&self, time_step_s: f64) -> f64 {
+        let sum: f64 = (0..self.count)
+            .map(|i| -self.squared_gap_changes[i] * self.steps_m[i])
+            .sum();
+        self.spacing_m * self.damping_s_m * 0.5 * self.stiffness_n_m2 * sum / time_step_s
+    }
+
+    /// The total force on the barrier over the last evaluated step (eq. 12), N:
+    /// `Δx_b Σ F_i` with the physical density `F_i = f̃_i · 2ρA/Δt²`.
+    pub fn total_force_n(&self, time_step_s: f64, linear_density_kg_m: f64) -> f64 {
+        let sum: f64 = self.forces[..self.count].iter().sum();
+        self.spacing_m * sum * 2.0 * linear_density_kg_m / (time_step_s * time_step_s)
+    }
+
+    /// The deepest penetration after the last evaluated step, m (0 when nothing touches).
+    pub fn max_penetration_after_step_m(&self) -> f64 {
+        (0..self.count)
+            .map(|i| self.gaps_m[i] - self.steps_m[i])
+            .fold(0.0, f64::max)
+    }
+
+    /// Forgets the last step's forces (used when a step needs no contact evaluation).
+    pub fn clear_step(&mut self) {
+        for i in 0..self.count {
+            self.steps_m[i] = 0.0;
+            self.forces[i] = 0.0;
+            self.jacobian[i] = 0.0;
+            self.squared_gap_changes[i] = 0.0;
+        }
+    }
+
+    /// Static contact at displacement `y`: adds the spring force `I* k⌊a⌋` (N/m) into
+    /// `force` and `I* k H(a) I` into `jacobian` (for the static equilibrium solve).
+    pub fn add_static_contact(
+        &self,
+        displacement: &[f64],
+        force: &mut [f64],
+        jacobian: &mut SymmetricBanded,
+    ) {
+        let last_free = self.string_intervals - 1;
+        for i in 0..self.count {
+            let gap = self.heights_m[i] - self.interpolate(displacement, i);
+            if gap <= 0.0 {
+                continue;
+            }
+            let first = self.stencil_first_node[i];
+            let w = &self.stencil_weights[i];
+            let point_force = self.transpose_scale * self.stiffness_n_m2 * gap;
+            let point_stiffness = self.transpose_scale * self.stiffness_n_m2;
+            for j in 0..4 {
+                let row_node = first + j;
+                if !(1..=last_free).contains(&row_node) {
+                    continue;
+                }
+                force[row_node] += w[j] * point_force;
+                for k in 0..=j {
+                    let column_node = first + k;
+                    if (1..=last_free).contains(&column_node) {
+                        jacobian.add(row_node - 1, column_node - 1, point_stiffness * w[j] * w[k]);
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cubic_interpolation_is_exact_for_cubics() {
+        let intervals = 20;
+        let dx = 0.01;
+        let cubic = |x: f64| 2.0 - 3.0 * x + 40.0 * x * x - 900.0 * x * x * x;
+        let values: Vec<f64> = (0..=intervals).map(|m| cubic(m as f64 * dx)).collect();
+        let mut grid = BarrierGrid::with_capacity(50, intervals);
+        // Points across the whole string, including the end intervals with shifted stencils.
+        grid.place(0.0003, 0.0041, 49, dx, |_| 0.0);
+        for i in 0..grid.len() {
+            let x = grid.positions_m()[i];
+            assert!(
+                (grid.interpolate(&values, i) - cubic(x)).abs() < 1e-12,
+                "x = {x}"
+            );
+        }
+    }
+
+    #[test]
+    fn weights_sum_to_one_and_hit_nodes_exactly() {
+        for &position in &[3.0, 3.25, 0.4, 19.9, 7.999] {
+            let (first, weights) = lagrange_stencil(position, 20);
+            assert!((weights.iter().sum::<f64>() - 1.0).abs() < 1e-14);
+            assert!(first + 3 <= 20);
+        }
+        let (first, weights) = lagrange_stencil(5.0, 20);
+        assert_eq!(first, 4);
+        assert_eq!(weights, [0.0, 1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn scaled_transpose_preserves_work() {
+        // Δx (I* f̃)·s must equal Δx_b f̃·s̃ for any forces and steps.
+        let intervals = 30;
+        let dx = 0.02;
+        let mut grid = BarrierGrid::with_capacity(40, intervals);
+        grid.place(0.05, 0.0037, 40, dx, |x| 1e-4 * (x * 50.0).sin());
+        grid.set_law(1e8, 0.0, 1e-5, 5e-4);
+        let displacement = vec![0.0; intervals + 1];
+        grid.begin_step(&displacement);
+        let mut step: Vec<f64> = (0..=intervals)
+            .map(|m| -2e-4 * (m as f64 * 0.3).cos())
+            .collect();
+        step[0] = 0.0;
+        step[intervals] = 0.0;
+        grid.evaluate(&step);
+        assert!(grid.has_force());
+        let mut spread = vec![0.0; intervals + 1];
+        grid.spread_forces(&mut spread);
+        let string_work: f64 = dx * spread.iter().zip(&step).map(|(f, s)| f * s).sum::<f64>();
+        let barrier_work: f64 = 0.0037
+            * (0..grid.len())
+                .map(|i| grid.forces[i] * grid.steps_m[i])
+                .sum::<f64>();
+        assert!((string_work - barrier_work).abs() < 1e-12 * barrier_work.abs());
+    }
+}

@@ -1,0 +1,519 @@
+//! The tanpura voice (one string at an oversampled rate, decimated to the output rate) and the
+//! four-string instrument.
+//!
+//! A voice maps musician-facing settings in SI units onto [`TanpuraString`]: the tension follows
+//! the pitch, `T = ρA (2 L_s f)² / (1 + B)` with the speaking length `L_s` from the thread (or the
+//! bridge crest) to the nut and the stiff-string correction `B = π² EI / (T L_s²)` (solved by a
+//! fixed-point pass); the scheme runs at `oversample ×` the output rate (seed 000: 4 × 44.1 kHz)
+//! and a Kaiser-windowed FIR (`decimator.rs`) brings it down. The output is the pickup mix of the
+//! nut force (eq. 13) and the bridge force (eq. 12) minus their values at rest, so a silent string
+//! outputs exactly 0 and carries no DC.
+//!
+//! A voice whose vibration energy has fallen below [`SLEEP_ENERGY_J`] (−86 dB below a typical
+//! pluck) is put exactly at rest and sleeps: no computation at all until its next pluck, once the
+//! decimator's tail has been flushed.
+
+use crate::decimator::Decimator;
+use crate::excitation::Pluck;
+use crate::newton::{NewtonSettings, NewtonStats};
+use crate::string_operator::StringParameters;
+use crate::tanpura_string::{TanpuraString, TanpuraStringConfig, ThreadSettings};
+use std::fmt;
+
+/// Vibration energy below which a string sleeps, J. A 2 mm pluck holds about 4e-4 J.
+pub const SLEEP_ENERGY_J: f64 = 1e-12;
+/// How often (in output samples) a voice checks whether it may sleep.
+const SLEEP_CHECK_INTERVAL: u32 = 256;
+/// Largest internal oversampling factor.
+pub const MAX_OVERSAMPLE: usize = 8;
+
+/// What a musician sets on one tanpura string, in SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VoiceSettings {
+    /// String pitch, Hz (20–2000).
+    pub fundamental_hz: f64,
+    /// k_b, N/m² (0–1e12; seed 1e8).
+    pub bridge_stiffness_n_m2: f64,
+    pub thread_enabled: bool,
+    /// x_c, m from the tuning bead (0.030–0.045; seed 0.040).
+    pub thread_position_m: f64,
+    /// False sets k_b = 0 beyond the thread.
+    pub bridge_beyond_thread: bool,
+    /// γ, 1/s (0–20; seed 0.6).
+    pub gamma_per_s: f64,
+    /// η, s (0–1e-6; seed 7e-9).
+    pub eta_s: f64,
+    /// Output = w · nut force + (1 − w) · bridge force (0–1).
+    pub nut_pickup_weight: f64,
+    /// Internal rate / output rate (1–8; seed 4).
+    pub oversample: usize,
+    /// Newton tolerance, m (1e-15–1e-6).
+    pub newton_tolerance: f64,
+    /// Newton iteration cap (1–100).
+    pub newton_max_iterations: u32,
+}
+
+/// The string pitch at which the seed's tension (31.47 N) is reached with the default thread.
+pub fn reference_fundamental_hz() -> f64 {
+    let config = TanpuraStringConfig::REFERENCE;
+    let speaking = config.string.length_m - config.speaking_start_m();
+    let p = config.string;
+    let stiffness_factor = 1.0
+        + std::f64::consts::PI.powi(2) * p.bending_stiffness_n_m2
+            / (p.tension_n * speaking * speaking);
+    p.wave_speed_m_s() / (2.0 * speaking) * stiffness_factor.sqrt()
+}
+
+impl Default for VoiceSettings {
+    /// The seed's reference string and configuration.
+    fn default() -> Self {
+        Self {
+            fundamental_hz: reference_fundamental_hz(),
+            bridge_stiffness_n_m2: 1e8,
+            thread_enabled: true,
+            thread_position_m: ThreadSettings::SEED.position_m,
+            bridge_beyond_thread: true,
+            gamma_per_s: StringParameters::SEED.gamma_per_s,
+            eta_s: StringParameters::SEED.eta_s,
+            nut_pickup_weight: 1.0,
+            oversample: 4,
+            newton_tolerance: NewtonSettings::REFERENCE.tolerance_m,
+            newton_max_iterations: NewtonSettings::REFERENCE.max_iterations,
+        }
+    }
+}
+
+/// A setting outside its valid range.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SettingsError {
+    pub field: &'static str,
+    pub value: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+impl fmt::Display for SettingsError {
+    fn fmt(&self, formatter: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            formatter,
+            "`{}` = {} is out of range, expected {} to {}",
+            self.field, self.value, self.min, self.max
+        )
+    }
+}
+
+impl std::error::Error for SettingsError {}
+
+impl VoiceSettings {
+    pub const FUNDAMENTAL_RANGE_HZ: (f64, f64) = (20.0, 2000.0);
+    pub const BRIDGE_STIFFNESS_RANGE: (f64, f64) = (0.0, 1e12);
+    pub const GAMMA_RANGE: (f64, f64) = (0.0, 20.0);
+    pub const ETA_RANGE: (f64, f64) = (0.0, 1e-6);
+    pub const TOLERANCE_RANGE: (f64, f64) = (1e-15, 1e-6);
+    pub const ITERATION_RANGE: (u32, u32) = (1, 100);
+
+    fn ranges(&self) -> [(&'static str, f64, (f64, f64)); 9] {
+        [
+            (
+                "fundamental_hz",
+                self.fundamental_hz,
+                Self::FUNDAMENTAL_RANGE_HZ,
+            ),
+            (
+                "bridge_stiffness_n_m2",
+                self.bridge_stiffness_n_m2,
+                Self::BRIDGE_STIFFNESS_RANGE,
+            ),
+            (
+                "thread_position_m",
+                self.thread_position_m,
+                ThreadSettings::POSITION_RANGE_M,
+            ),
+            ("gamma_per_s", self.gamma_per_s, Self::GAMMA_RANGE),
+            ("eta_s", self.eta_s, Self::ETA_RANGE),
+            ("nut_pickup_weight", self.nut_pickup_weight, (0.0, 1.0)),
+            (
+                "oversample",
+                self.oversample as f64,
+                (1.0, MAX_OVERSAMPLE as f64),
+            ),
+            (
+                "newton_tolerance",
+                self.newton_tolerance,
+                Self::TOLERANCE_RANGE,
+            ),
+            (
+                "newton_max_iterations",
+                self.newton_max_iterations as f64,
+                (
+                    Self::ITERATION_RANGE.0 as f64,
+                    Self::ITERATION_RANGE.1 as f64,
+                ),
+            ),
+        ]
+    }
+
+    /// Checks every field; the error names the first one out of range (NaN is out of range).
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        for (field, value, (min, max)) in self.ranges() {
+            if !(min <= value && value <= max) {
+                return Err(SettingsError {
+                    field,
+                    value,
+                    min,
+                    max,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The nearest valid settings (NaN becomes the default). For the audio thread.
+    pub fn clamped(&self) -> Self {
+        let default = Self::default();
+        let clamp = |value: f64, (min, max): (f64, f64), fallback: f64| {
+            if value.is_nan() {
+                fallback
+            } else {
+                value.clamp(min, max)
+            }
+        };
+        Self {
+            fundamental_hz: clamp(
+                self.fundamental_hz,
+                Self::FUNDAMENTAL_RANGE_HZ,
+                default.fundamental_hz,
+            ),
+            bridge_stiffness_n_m2: clamp(
+                self.bridge_stiffness_n_m2,
+                Self::BRIDGE_STIFFNESS_RANGE,
+                default.bridge_stiffness_n_m2,
+            ),
+            thread_enabled: self.thread_enabled,
+            thread_position_m: clamp(
+                self.thread_position_m,
+                ThreadSettings::POSITION_RANGE_M,
+                default.thread_position_m,
+            ),
+            bridge_beyond_thread: self.bridge_beyond_thread,
+            gamma_per_s: clamp(self.gamma_per_s, Self::GAMMA_RANGE, default.gamma_per_s),
+            eta_s: clamp(self.eta_s, Self::ETA_RANGE, default.eta_s),
+            nut_pickup_weight: clamp(self.nut_pickup_weight, (0.0, 1.0), 1.0),
+            oversample: self.oversample.clamp(1, MAX_OVERSAMPLE),
+            newton_tolerance: clamp(
+                self.newton_tolerance,
+                Self::TOLERANCE_RANGE,
+                default.newton_tolerance,
+            ),
+            newton_max_iterations: self
+                .newton_max_iterations
+                .clamp(Self::ITERATION_RANGE.0, Self::ITERATION_RANGE.1),
+        }
+    }
+
+    /// The string configuration these settings describe at `output_sample_rate_hz`.
+    pub fn string_config(&self, output_sample_rate_hz: f64) -> TanpuraStringConfig {
+        let mut config = TanpuraStringConfig::REFERENCE;
+        config.time_step_s = 1.0 / (output_sample_rate_hz * self.oversample as f64);
+        config.bridge.stiffness_n_m2 = self.bridge_stiffness_n_m2;
+        config.bridge.beyond_thread = self.bridge_beyond_thread;
+        config.thread = self.thread_enabled.then_some(ThreadSettings {
+            position_m: self.thread_position_m,
+            ..ThreadSettings::SEED
+        });
+        config.string.gamma_per_s = self.gamma_per_s;
+        config.string.eta_s = self.eta_s;
+        config.string.tension_n = tension_for_pitch_n(&config, self.fundamental_hz);
+        config.newton = NewtonSettings {
+            tolerance_m: self.newton_tolerance,
+            max_iterations: self.newton_max_iterations,
+        };
+        config
+    }
+}
+
+/// The tension that tunes the speaking length of `config`'s string to `fundamental_hz`:
+/// `f = (1/2L_s) √(T/ρA) √(1 + B)`, `B = π² EI/(T L_s²)`, solved for T by fixed point.
+pub fn tension_for_pitch_n(config: &TanpuraStringConfig, fundamental_hz: f64) -> f64 {
+    let p = config.string;
+    let speaking = p.length_m - config.speaking_start_m();
+    let ideal = p.linear_density_kg_m * (2.0 * speaking * fundamental_hz).powi(2);
+    let mut tension = ideal;
+    for _ in 0..8 {
+        let b = std::f64::consts::PI.powi(2) * p.bending_stiffness_n_m2
+            / (tension * speaking * speaking);
+        tension = ideal / (1.0 + b);
+    }
+    tension
+}
+
+/// One tanpura string with its oversampling and decimation; allocation-free after `new`.
+#[derive(Debug, Clone)]
+pub struct TanpuraVoice {
+    settings: VoiceSettings,
+    output_sample_rate_hz: f64,
+    string: TanpuraString,
+    /// One decimator per oversampling factor, built up front so that changing it never
+    /// allocates.
+    decimators: Vec<Decimator>,
+    sleeping: bool,
+    /// Output samples of zeros still to push through the decimator after falling asleep.
+    tail_remaining: usize,
+    samples_since_sleep_check: u32,
+}
+
+impl TanpuraVoice {
+    /// A silent voice at rest. Invalid settings are clamped. Allocates.
+    pub fn new(settings: &VoiceSettings, output_sample_rate_hz: f64) -> Self {
+        let settings = settings.clamped();
+        // Built with a thread so that its grid exists if the thread is switched on later.
+        let mut build = settings;
+        build.thread_enabled = true;
+        let mut string = TanpuraString::new(build.string_config(output_sample_rate_hz));
+        string.set_config(settings.string_config(output_sample_rate_hz));
+        string.reset();
+        let decimators = (1..=MAX_OVERSAMPLE).map(Decimator::new).collect();
+        Self {
+            settings,
+            output_sample_rate_hz,
+            string,
+            decimators,
+            sleeping: true,
+            tail_remaining: 0,
+            samples_since_sleep_check: 0,
+        }
+    }
+
+    /// Applies new settings (clamped) without allocating. The string keeps ringing.
+    pub fn set_settings(&mut self, settings: &VoiceSettings) {
+        let settings = settings.clamped();
+        if settings == self.settings {
+            return;
+        }
+        if settings.oversample != self.settings.oversample {
+            self.decimators[settings.oversample - 1].reset();
+        }
+        self.settings = settings;
+        self.string
+            .set_config(settings.string_config(self.output_sample_rate_hz));
+        if self.sleeping {
+            self.string.settle_to_rest();
+        }
+    }
+
+    pub fn settings(&self) -> &VoiceSettings {
+        &self.settings
+    }
+
+    /// Plucks the string (and wakes it). Allocation-free.
+    pub fn pluck(&mut self, pluck: &Pluck) {
+        self.string.pluck(pluck);
+        self.sleeping = false;
+        self.tail_remaining = 0;
+        self.samples_since_sleep_check = 0;
+    }
+
+    /// The seed's "first mode" excitation (and wakes the string).
+    pub fn excite_first_mode(&mut self, amplitude_m: f64) {
+        self.string.excite_first_mode(amplitude_m);
+        self.sleeping = false;
+        self.tail_remaining = 0;
+    }
+
+    fn pickup_n(&self) -> f64 {
+        let w = self.settings.nut_pickup_weight;
+        let nut = self.string.nut_force_n() - self.string.rest_nut_force_n();
+        let bridge = self.string.bridge_force_n() - self.string.rest_bridge_force_n();
+        w * nut + (1.0 - w) * bridge
+    }
+
+    /// One output-rate sample of the pickup signal, N.
+    pub fn next_sample(&mut self) -> f32 {
+        let which = self.settings.oversample - 1;
+        if self.sleeping {
+            if self.tail_remaining == 0 {
+                return 0.0;
+            }
+            self.tail_remaining -= 1;
+            let decimator = &mut self.decimators[which];
+            let mut output = 0.0;
+            for _ in 0..decimator.factor() {
+                if let Some(y) = decimator.push(0.0) {
+                    output = y;
+                }
+            }
+            return output as f32;
+        }
+        let mut output = 0.0;
+        for _ in 0..self.settings.oversample {
+            self.string.step();
+            let pickup = self.pickup_n();
+            if let Some(y) = self.decimators[which].push(pickup) {
+                output = y;
+            }
+        }
+        self.samples_since_sleep_check += 1;
+        if self.samples_since_sleep_check >= SLEEP_CHECK_INTERVAL {
+            self.samples_since_sleep_check = 0;
+            if self.string.vibration_energy_j() < SLEEP_ENERGY_J {
+                self.string.settle_to_rest();
+                self.sleeping = true;
+                let decimator = &self.decimators[which];
+                self.tail_remaining = decimator.taps().len() / decimator.factor() + 1;
+            }
+        }
+        output as f32
+    }
+
+    /// Fills `output` with consecutive samples (overwrites).
+    pub fn process(&mut self, output: &mut [f32]) {
+        for sample in output {
+            *sample = self.next_sample();
+        }
+    }
+
+    /// False once the string has decayed and sleeps (no computation until the next pluck).
+    pub fn is_active(&self) -> bool {
+        !self.sleeping || self.tail_remaining > 0
+    }
+
+    /// Silences the voice: string at rest, decimators cleared, statistics kept.
+    pub fn reset(&mut self) {
+        self.string.reset();
+        for decimator in &mut self.decimators {
+            decimator.reset();
+        }
+        self.sleeping = true;
+        self.tail_remaining = 0;
+    }
+
+    /// The current pickup value at the internal rate, N (before decimation).
+    pub fn pickup_internal_n(&self) -> f64 {
+        self.pickup_n()
+    }
+
+    pub fn string(&self) -> &TanpuraString {
+        &self.string
+    }
+
+    pub fn newton_stats(&self) -> &NewtonStats {
+        self.string.newton_stats()
+    }
+
+    /// Output latency of the decimation filter, samples at the output rate.
+    pub fn latency_samples(&self) -> f64 {
+        self.decimators[self.settings.oversample - 1].delay_output_samples()
+    }
+}
+
+/// The interval of the first drone string below Sa.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FirstString {
+    /// The fifth: 3/4 of Sa (Pa of the lower octave).
+    Pa,
+    /// The fourth: 2/3 of Sa (Ma of the lower octave).
+    Ma,
+    /// The major seventh: 15/16 of Sa (Ni of the lower octave).
+    Ni,
+}
+
+impl FirstString {
+    /// Frequency ratio to Sa.
+    pub fn ratio(self) -> f64 {
+        match self {
+            FirstString::Pa => 3.0 / 4.0,
+            FirstString::Ma => 2.0 / 3.0,
+            FirstString::Ni => 15.0 / 16.0,
+        }
+    }
+}
+
+/// The four-string drone: first string (Pa, Ma or Ni), Sa, Sa, low Sa.
+#[derive(Debug, Clone)]
+pub struct Tanpura {
+    voices: [TanpuraVoice; 4],
+    settings: VoiceSettings,
+    sa_hz: f64,
+    first_string: FirstString,
+}
+
+impl Tanpura {
+    /// Frequency ratios of the four strings to Sa for a given first string.
+    pub fn tuning(first_string: FirstString) -> [f64; 4] {
+        [first_string.ratio(), 1.0, 1.0, 0.5]
+    }
+
+    /// The instrument tuned to `sa_hz`; `settings` apply to every string except its pitch.
+    /// Allocates.
+    pub fn new(settings: &VoiceSettings, sa_hz: f64, output_sample_rate_hz: f64) -> Self {
+        let ratios = Self::tuning(FirstString::Pa);
+        let voices = ratios.map(|ratio| {
+            let mut string_settings = *settings;
+            string_settings.fundamental_hz = sa_hz * ratio;
+            TanpuraVoice::new(&string_settings, output_sample_rate_hz)
+        });
+        Self {
+            voices,
+            settings: *settings,
+            sa_hz,
+            first_string: FirstString::Pa,
+        }
+    }
+
+    /// Retunes and reconfigures every string without allocating.
+    pub fn set_tuning(&mut self, settings: &VoiceSettings, sa_hz: f64, first_string: FirstString) {
+        self.settings = *settings;
+        self.sa_hz = sa_hz;
+        self.first_string = first_string;
+        for (voice, ratio) in self.voices.iter_mut().zip(Self::tuning(first_string)) {
+            let mut string_settings = *settings;
+            string_settings.fundamental_hz = sa_hz * ratio;
+            voice.set_settings(&string_settings);
+        }
+    }
+
+    pub fn sa_hz(&self) -> f64 {
+        self.sa_hz
+    }
+
+    pub fn first_string(&self) -> FirstString {
+        self.first_string
+    }
+
+    /// Plucks string `index` (0 = first string … 3 = low Sa); other indices are ignored.
+    pub fn pluck(&mut self, index: usize, pluck: &Pluck) {
+        if let Some(voice) = self.voices.get_mut(index) {
+            voice.pluck(pluck);
+        }
+    }
+
+    /// One output sample: the sum of the four strings' pickups, N. Sleeping strings cost
+    /// nothing.
+    pub fn next_sample(&mut self) -> f32 {
+        self.voices.iter_mut().map(TanpuraVoice::next_sample).sum()
+    }
+
+    pub fn voices(&self) -> &[TanpuraVoice; 4] {
+        &self.voices
+    }
+
+    /// Number of strings currently computing.
+    pub fn active_strings(&self) -> usize {
+        self.voices.iter().filter(|voice| voice.is_active()).count()
+    }
+
+    /// Newton statistics of all four strings together.
+    pub fn newton_stats(&self) -> NewtonStats {
+        let mut stats = NewtonStats::default();
+        for voice in &self.voices {
+            stats.merge(voice.newton_stats());
+        }
+        stats
+    }
+
+    pub fn reset(&mut self) {
+        for voice in &mut self.voices {
+            voice.reset();
+        }
+    }
+}

@@ -1,0 +1,803 @@
+//! One tanpura string in distributed contact with a curved bridge and a cotton thread, stepped
+//! one sample of the internal rate at a time.
+//!
+//! Source: seed 000 (van Walstijn & Chatziioannou, ISMA 2014), eq. 5–25, restated in
+//! `shared/notes/tanpura-model.md`; configuration "B" of its Figure 2 (the string runs from the
+//! tuning bead at x = 0, over the thread and the bridge, to the nut at x = L).
+//!
+//! Each step finds `s = yⁿ⁺¹ − yⁿ` as the root of eq. 22 and updates `yⁿ⁺¹ = yⁿ + s`,
+//! `qⁿ⁺¹ = s − qⁿ` (eq. 16). The step first solves the linear part alone with the prefactorised
+//! `A` (the string without contact). If no barrier point has a positive gap before or after that
+//! step, no contact force acts and the linear step *is* the exact root: Newton is skipped.
+//! Otherwise a bounded Newton iteration (`newton.rs`) starts from it.
+//!
+//! Geometry (the seed's measured bridge profile is not public, so this one is our own):
+//! - bridge: the parabola `y_b(x) = −(x − x_crest)²/(2 R_b)` with crest at 46.5 mm, y = 0, and
+//!   radius of curvature `R_b` = 0.1 m, over 25–60 mm (beyond that the string never reaches it);
+//! - thread: a cap on the bridge surface, `y_c(x) = y_b(x_c) + h_c − (x − x_c)²/(2 R_c)`, with
+//!   height `h_c` = 0.2 mm and an effective radius `R_c` = 20 mm (a compressible cotton thread
+//!   seen through k_c = 1e8 N/m²); at the default 40 mm its top lies 11 µm below the crest, so the
+//!   string rests on both and grazes the crest as it vibrates (the jawari);
+//! - finger: a parabolic tip of radius half its width (`excitation.rs`), 1 mm grid.
+//!
+//! Energy (eq. 8–9): `H = Σ Δx [p²/2ρA] + V_string + Δx_b Σ k_b/2⌊a⌋² + Δx_c Σ k_c/2⌊a⌋²`.
+//! The scheme gives `Hⁿ⁺¹ − Hⁿ = −(losses over the step)` exactly; a pluck changes H by the
+//! work the finger does, which is booked as external work. So at every step
+//! `H(n) + cumulative losses − external work = H(0)` to round-off.
+
+use crate::banded::{BandedLdlt, SymmetricBanded};
+use crate::barrier_grid::BarrierGrid;
+use crate::excitation::{finger_height_m, first_mode_shape, Pluck};
+use crate::newton::{solve_bounded, NewtonSettings, NewtonStats, NewtonSystem};
+use crate::string_operator::{StringOperator, StringParameters};
+
+/// The curved bridge (a one-sided barrier) and its contact law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BridgeSettings {
+    /// Position of the crest (highest point, y = 0), m from the tuning bead. Seed: 46.5 mm.
+    pub crest_position_m: f64,
+    /// Radius of curvature of the parabolic profile, m.
+    pub curvature_radius_m: f64,
+    /// Where the bridge grid starts and ends, m.
+    pub start_m: f64,
+    pub end_m: f64,
+    /// Δx_b, m. Seed: 0.18 mm.
+    pub spacing_m: f64,
+    /// k_b, N/m². Seed: 1e8. Zero removes the bridge.
+    pub stiffness_n_m2: f64,
+    /// r_b, s/m. Seed: 0.1.
+    pub damping_s_m: f64,
+    /// False sets k_b = 0 beyond the thread (x > x_c), the seed's Figure 5 comparison.
+    pub beyond_thread: bool,
+}
+
+impl BridgeSettings {
+    pub const SEED: BridgeSettings = BridgeSettings {
+        crest_position_m: 0.0465,
+        curvature_radius_m: 0.1,
+        start_m: 0.025,
+        end_m: 0.060,
+        spacing_m: 0.18e-3,
+        stiffness_n_m2: 1e8,
+        damping_s_m: 0.1,
+        beyond_thread: true,
+    };
+
+    /// Height of the bridge surface at `x`, m.
+    pub fn height_m(&self, x_m: f64) -> f64 {
+        let offset = x_m - self.crest_position_m;
+        -offset * offset / (2.0 * self.curvature_radius_m)
+    }
+}
+
+/// The cotton thread between string and bridge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThreadSettings {
+    /// x_c, m from the tuning bead. Seed: 40 mm. Valid 30–45 mm (on the bridge, before its crest).
+    pub position_m: f64,
+    /// Height of the thread's top above the bridge surface, m.
+    pub height_m: f64,
+    /// Effective radius of curvature of its top, m.
+    pub curvature_radius_m: f64,
+    /// Δx_c, m. Seed: 0.15 mm.
+    pub spacing_m: f64,
+    /// k_c, N/m². Seed: 1e8.
+    pub stiffness_n_m2: f64,
+    /// r_c, s/m. Seed: 0.1.
+    pub damping_s_m: f64,
+}
+
+impl ThreadSettings {
+    pub const SEED: ThreadSettings = ThreadSettings {
+        position_m: 0.040,
+        height_m: 0.18e-3,
+        curvature_radius_m: 0.020,
+        spacing_m: 0.15e-3,
+        stiffness_n_m2: 1e8,
+        damping_s_m: 0.1,
+    };
+    pub const POSITION_RANGE_M: (f64, f64) = (0.030, 0.045);
+
+    /// Half the length over which the thread's cap stands above the bridge surface, m.
+    pub fn half_width_m(&self) -> f64 {
+        (2.0 * self.curvature_radius_m * self.height_m).sqrt()
+    }
+
+    fn height_over(&self, bridge: &BridgeSettings, x_m: f64) -> f64 {
+        let offset = x_m - self.position_m;
+        bridge.height_m(self.position_m) + self.height_m
+            - offset * offset / (2.0 * self.curvature_radius_m)
+    }
+}
+
+/// The plucking finger's grid and contact law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FingerSettings {
+    /// Δx_f, m. Seed: 1 mm.
+    pub spacing_m: f64,
+    /// k_f while pressing, N/m².
+    pub stiffness_n_m2: f64,
+    /// r_f, s/m. Seed: 1.
+    pub damping_s_m: f64,
+}
+
+impl FingerSettings {
+    pub const SEED: FingerSettings = FingerSettings {
+        spacing_m: 1e-3,
+        stiffness_n_m2: 1e8,
+        damping_s_m: 1.0,
+    };
+}
+
+/// Everything that defines one simulated string.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TanpuraStringConfig {
+    pub string: StringParameters,
+    /// N, grid intervals over the length (200 gives the seed's Δx = 3⅓ mm, to 0.2 %).
+    pub intervals: usize,
+    /// Δt, s. Seed: 1/176 400 (4 × 44.1 kHz).
+    pub time_step_s: f64,
+    pub bridge: BridgeSettings,
+    /// `None`: no thread, and no thread grid work at all.
+    pub thread: Option<ThreadSettings>,
+    pub finger: FingerSettings,
+    pub newton: NewtonSettings,
+    /// Book the losses of every step (costs a few O(N) passes; tests and research tools).
+    pub track_energy: bool,
+}
+
+impl TanpuraStringConfig {
+    /// The seed's section 5: the reference configuration.
+    pub const REFERENCE: TanpuraStringConfig = TanpuraStringConfig {
+        string: StringParameters::SEED,
+        intervals: 200,
+        time_step_s: 1.0 / 176_400.0,
+        bridge: BridgeSettings::SEED,
+        thread: Some(ThreadSettings::SEED),
+        finger: FingerSettings::SEED,
+        newton: NewtonSettings::REFERENCE,
+        track_energy: false,
+    };
+
+    /// The same with all losses off (γ = η = r_b = r_c = 0).
+    pub fn lossless(mut self) -> Self {
+        self.string.gamma_per_s = 0.0;
+        self.string.eta_s = 0.0;
+        self.bridge.damping_s_m = 0.0;
+        if let Some(thread) = &mut self.thread {
+            thread.damping_s_m = 0.0;
+        }
+        self
+    }
+
+    /// Where the speaking length starts: the thread if present, else the bridge crest.
+    pub fn speaking_start_m(&self) -> f64 {
+        match self.thread {
+            Some(thread) => thread.position_m,
+            None => self.bridge.crest_position_m,
+        }
+    }
+}
+
+impl Default for TanpuraStringConfig {
+    fn default() -> Self {
+        Self::REFERENCE
+    }
+}
+
+/// Largest fingertip the finger grid has room for, m.
+const MAX_FINGER_WIDTH_M: f64 = 0.040;
+/// Static equilibrium: Newton on a piecewise-linear problem ends once the contact set settles.
+const STATIC_MAX_ITERATIONS: u32 = 100;
+const STATIC_TOLERANCE_M: f64 = 1e-16;
+
+/// The per-step solver state: the linear step matrix, the Jacobian and the barriers.
+#[derive(Debug, Clone)]
+struct StepSolver {
+    intervals: usize,
+    /// A of eq. 15, and its factorisation for the contact-free predictor.
+    step_matrix: SymmetricBanded,
+    step_factor: BandedLdlt,
+    jacobian: SymmetricBanded,
+    jacobian_factor: BandedLdlt,
+    /// s, full-node vector (zero at the fixed ends).
+    step: Vec<f64>,
+    /// 2(D yⁿ − d_b − qⁿ), the constant part of the residual.
+    constant: Vec<f64>,
+    /// Σ I* f̃ on the string nodes.
+    contact: Vec<f64>,
+    residual: Vec<f64>,
+    bridge: BarrierGrid,
+    thread: BarrierGrid,
+    finger: BarrierGrid,
+}
+
+impl NewtonSystem for StepSolver {
+    fn newton_update(&mut self) -> Option<f64> {
+        let n = self.intervals;
+        self.contact.fill(0.0);
+        self.jacobian.copy_from(&self.step_matrix);
+        for barrier in [&mut self.bridge, &mut self.thread, &mut self.finger] {
+            if barrier.is_active() {
+                barrier.evaluate(&self.step);
+                barrier.spread_forces(&mut self.contact);
+                barrier.add_jacobian(&mut self.jacobian);
+            }
+        }
+        // F(s) = A s + constant − Σ I* f̃ (eq. 22).
+        self.step_matrix
+            .multiply(&self.step[1..n], &mut self.residual[..n - 1]);
+        for m in 1..n {
+            self.residual[m - 1] += self.constant[m] - self.contact[m];
+        }
+        self.jacobian_factor.factorise(&self.jacobian).ok()?;
+        self.jacobian_factor
+            .solve_in_place(&mut self.residual[..n - 1]);
+        let mut largest = 0.0f64;
+        for m in 1..n {
+            let delta = self.residual[m - 1];
+            self.step[m] -= delta;
+            largest = largest.max(delta.abs());
+        }
+        Some(largest)
+    }
+}
+
+/// One tanpura string; allocation-free after [`TanpuraString::new`].
+#[derive(Debug, Clone)]
+pub struct TanpuraString {
+    config: TanpuraStringConfig,
+    operator: StringOperator,
+    solver: StepSolver,
+    /// y, full-node vector: y[0] = y_TB, y[N] = 0.
+    displacement: Vec<f64>,
+    /// q = (Δt/2ρA) p, full-node vector, zero at the ends.
+    scaled_momentum: Vec<f64>,
+    /// The static equilibrium on bridge and thread (no finger, no motion).
+    rest_displacement: Vec<f64>,
+    scratch: Vec<f64>,
+    stats: NewtonStats,
+    nut_force_n: f64,
+    bridge_force_n: f64,
+    rest_nut_force_n: f64,
+    rest_bridge_force_n: f64,
+    max_penetration_m: f64,
+    cumulative_losses_j: f64,
+    external_work_j: f64,
+    static_solve_failures: u64,
+    non_finite_resets: u64,
+}
+
+impl TanpuraString {
+    /// Builds the string and settles it at rest on bridge and thread. Allocates.
+    pub fn new(config: TanpuraStringConfig) -> Self {
+        let n = config.intervals;
+        let operator = StringOperator::new(config.string, n, config.time_step_s);
+        let bridge_capacity = grid_points(
+            config.bridge.start_m,
+            config.bridge.end_m,
+            config.bridge.spacing_m,
+        );
+        let thread_capacity = match config.thread {
+            Some(thread) => grid_points(0.0, 2.0 * thread.half_width_m(), thread.spacing_m),
+            None => 0,
+        };
+        let finger_capacity = grid_points(0.0, MAX_FINGER_WIDTH_M, config.finger.spacing_m);
+        let solver = StepSolver {
+            intervals: n,
+            step_matrix: SymmetricBanded::zeros(n - 1, 2),
+            step_factor: BandedLdlt::with_shape(n - 1, 2),
+            jacobian: SymmetricBanded::zeros(n - 1, 3),
+            jacobian_factor: BandedLdlt::with_shape(n - 1, 3),
+            step: vec![0.0; n + 1],
+            constant: vec![0.0; n + 1],
+            contact: vec![0.0; n + 1],
+            residual: vec![0.0; n + 1],
+            bridge: BarrierGrid::with_capacity(bridge_capacity, n),
+            thread: BarrierGrid::with_capacity(thread_capacity, n),
+            finger: BarrierGrid::with_capacity(finger_capacity, n),
+        };
+        let mut string = Self {
+            config,
+            operator,
+            solver,
+            displacement: vec![0.0; n + 1],
+            scaled_momentum: vec![0.0; n + 1],
+            rest_displacement: vec![0.0; n + 1],
+            scratch: vec![0.0; n + 1],
+            stats: NewtonStats::default(),
+            nut_force_n: 0.0,
+            bridge_force_n: 0.0,
+            rest_nut_force_n: 0.0,
+            rest_bridge_force_n: 0.0,
+            max_penetration_m: 0.0,
+            cumulative_losses_j: 0.0,
+            external_work_j: 0.0,
+            static_solve_failures: 0,
+            non_finite_resets: 0,
+        };
+        string.apply_config();
+        string.reset();
+        string
+    }
+
+    /// Changes the configuration without reallocating. The grid (`intervals`) and string
+    /// length must stay as built, and a thread can only be moved or removed if the
+    /// string was built with one (its grid needs room). Returns false, changing nothing, when
+    /// the new configuration does not fit. The string keeps vibrating; its rest state is
+    /// recomputed.
+    pub fn set_config(&mut self, config: TanpuraStringConfig) -> bool {
+        let thread_fits = config.thread.map_or(true, |thread| {
+            grid_points(0.0, 2.0 * thread.half_width_m(), thread.spacing_m)
+                <= self.solver.thread.capacity()
+        });
+        let bridge_fits = grid_points(
+            config.bridge.start_m,
+            config.bridge.end_m,
+            config.bridge.spacing_m,
+        ) <= self.solver.bridge.capacity();
+        let fits = config.intervals == self.config.intervals
+            && config.time_step_s > 0.0
+            && config.string.length_m == self.config.string.length_m
+            && thread_fits
+            && bridge_fits;
+        if !fits {
+            return false;
+        }
+        if config != self.config {
+            self.config = config;
+            self.apply_config();
+            self.update_rest_state();
+        }
+        true
+    }
+
+    fn apply_config(&mut self) {
+        let config = self.config;
+        let dt = config.time_step_s;
+        let density = config.string.linear_density_kg_m;
+        self.operator.set_parameters(config.string);
+        self.operator.step_matrix_into(&mut self.solver.step_matrix);
+        self.solver
+            .step_factor
+            .factorise(&self.solver.step_matrix)
+            .expect("the string's step matrix is positive definite for positive T, EI, ρA");
+        let dx = self.operator.spacing_m();
+
+        let bridge = config.bridge;
+        let bridge_end = match (bridge.beyond_thread, config.thread) {
+            (false, Some(thread)) => bridge.end_m.min(thread.position_m),
+            _ => bridge.end_m,
+        };
+        let bridge_points = if bridge.stiffness_n_m2 > 0.0 && bridge_end > bridge.start_m {
+            grid_points(bridge.start_m, bridge_end, bridge.spacing_m)
+        } else {
+            0
+        };
+        self.solver
+            .bridge
+            .place(bridge.start_m, bridge.spacing_m, bridge_points, dx, |x| {
+                bridge.height_m(x)
+            });
+        self.solver
+            .bridge
+            .set_law(bridge.stiffness_n_m2, bridge.damping_s_m, dt, density);
+
+        match config.thread {
+            Some(thread) => {
+                let half_width = thread.half_width_m();
+                let points = grid_points(0.0, 2.0 * half_width, thread.spacing_m);
+                self.solver.thread.place(
+                    thread.position_m - half_width,
+                    thread.spacing_m,
+                    points,
+                    dx,
+                    |x| thread.height_over(&bridge, x),
+                );
+                self.solver
+                    .thread
+                    .set_law(thread.stiffness_n_m2, thread.damping_s_m, dt, density);
+            }
+            None => {
+                self.solver.thread.place(0.0, 1.0, 0, dx, |_| 0.0);
+                self.solver.thread.set_law(0.0, 0.0, dt, density);
+            }
+        }
+        // The finger only acts while pressing (`pluck`); between plucks k_f = 0.
+        self.solver.finger.place(0.0, 1.0, 0, dx, |_| 0.0);
+        self.solver.finger.set_law(0.0, 0.0, dt, density);
+    }
+
+    /// Puts the string at rest on bridge and thread and clears every statistic and ledger.
+    pub fn reset(&mut self) {
+        self.update_rest_state();
+        self.displacement.copy_from_slice(&self.rest_displacement);
+        self.scaled_momentum.fill(0.0);
+        self.stats = NewtonStats::default();
+        self.nut_force_n = self.rest_nut_force_n;
+        self.bridge_force_n = self.rest_bridge_force_n;
+        self.max_penetration_m = 0.0;
+        self.cumulative_losses_j = 0.0;
+        self.external_work_j = 0.0;
+        self.static_solve_failures = 0;
+        self.non_finite_resets = 0;
+    }
+
+    /// Recomputes the static rest state (and the forces it puts on nut and bridge) for the
+    /// current configuration, leaving the moving string untouched.
+    fn update_rest_state(&mut self) {
+        let n = self.config.intervals;
+        let left = self.config.string.left_support_m;
+        let mut rest = std::mem::take(&mut self.rest_displacement);
+        // Start from the straight line between the supports.
+        for (m, y) in rest.iter_mut().enumerate() {
+            *y = left * (1.0 - m as f64 / n as f64);
+        }
+        if !self.solve_static(&mut rest) {
+            self.static_solve_failures += 1;
+        }
+        self.rest_nut_force_n = self.operator.nut_force_n(&rest);
+        self.rest_bridge_force_n = self.static_barrier_force_n(&rest);
+        self.rest_displacement = rest;
+    }
+
+    /// The total static force of bridge and thread on the string at `displacement`, N.
+    fn static_barrier_force_n(&self, displacement: &[f64]) -> f64 {
+        [&self.solver.bridge, &self.solver.thread]
+            .iter()
+            .filter(|barrier| barrier.is_active())
+            .map(|barrier| {
+                let stiffness = barrier.stiffness_n_m2();
+                let spacing = if barrier.len() > 1 {
+                    barrier.positions_m()[1] - barrier.positions_m()[0]
+                } else {
+                    0.0
+                };
+                (0..barrier.len())
+                    .map(|i| {
+                        let gap = barrier.heights_m()[i] - barrier.interpolate(displacement, i);
+                        stiffness * gap.max(0.0)
+                    })
+                    .sum::<f64>()
+                    * spacing
+            })
+            .sum()
+    }
+
+    /// Solves the static equilibrium `K y − b = Σ I* k⌊y_barrier − I y⌋` (every active barrier,
+    /// the finger included) by Newton's method from `displacement`, in place. The contact law
+    /// is piecewise linear, so Newton ends exactly once the contact set stops changing.
+    /// Returns whether it converged within the cap.
+    fn solve_static(&mut self, displacement: &mut [f64]) -> bool {
+        let n = self.config.intervals;
+        displacement[0] = self.config.string.left_support_m;
+        displacement[n] = 0.0;
+        for _ in 0..STATIC_MAX_ITERATIONS {
+            let solver = &mut self.solver;
+            self.operator
+                .restoring_force(displacement, &mut solver.residual);
+            solver.contact.fill(0.0);
+            solver.jacobian.copy_from(self.operator.stiffness_matrix());
+            for barrier in [&solver.bridge, &solver.thread, &solver.finger] {
+                if barrier.is_active() {
+                    barrier.add_static_contact(
+                        displacement,
+                        &mut solver.contact,
+                        &mut solver.jacobian,
+                    );
+                }
+            }
+            // G(y) on the interior, shifted down one index for the solver.
+            for m in 1..n {
+                solver.residual[m - 1] = solver.residual[m] - solver.contact[m];
+            }
+            if solver.jacobian_factor.factorise(&solver.jacobian).is_err() {
+                return false;
+            }
+            solver
+                .jacobian_factor
+                .solve_in_place(&mut solver.residual[..n - 1]);
+            let mut largest = 0.0f64;
+            for m in 1..n {
+                displacement[m] -= solver.residual[m - 1];
+                largest = largest.max(solver.residual[m - 1].abs());
+            }
+            if !largest.is_finite() {
+                return false;
+            }
+            if largest <= STATIC_TOLERANCE_M {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// The seed's finger pluck: press the finger (k_f > 0) until the string is in static
+    /// equilibrium against finger, bridge and thread, then release it (k_f → 0). The string's
+    /// previous motion is stopped by the finger. The energy this adds is booked as external
+    /// work. Allocation-free.
+    pub fn pluck(&mut self, pluck: &Pluck) {
+        let energy_before = self.energy_j();
+        let length = self.config.string.length_m;
+        let width = pluck.width_m.clamp(
+            Pluck::WIDTH_RANGE_M.0,
+            Pluck::WIDTH_RANGE_M.1.min(MAX_FINGER_WIDTH_M),
+        );
+        let amplitude = pluck
+            .amplitude_m
+            .clamp(Pluck::AMPLITUDE_RANGE_M.0, Pluck::AMPLITUDE_RANGE_M.1);
+        let half_width = 0.5 * width;
+        let lowest = self.config.speaking_start_m() + half_width + 1e-3;
+        let highest = length - half_width - 1e-3;
+        let centre = pluck.position_m.clamp(lowest, highest.max(lowest));
+        let dx = self.operator.spacing_m();
+        // The finger's top sits `amplitude` above the rest shape under its centre.
+        let rest_under_centre = interpolate_full(&self.rest_displacement, centre / dx);
+        let top = rest_under_centre + amplitude;
+        let spacing = self.config.finger.spacing_m;
+        let points = grid_points(0.0, width, spacing);
+        self.solver
+            .finger
+            .place(centre - half_width, spacing, points, dx, |x| {
+                finger_height_m(x, centre, width, top)
+            });
+        self.solver.finger.set_law(
+            self.config.finger.stiffness_n_m2,
+            self.config.finger.damping_s_m,
+            self.config.time_step_s,
+            self.config.string.linear_density_kg_m,
+        );
+        let mut pressed = std::mem::take(&mut self.displacement);
+        if !self.solve_static(&mut pressed) {
+            self.static_solve_failures += 1;
+        }
+        self.displacement = pressed;
+        self.scaled_momentum.fill(0.0);
+        // Release.
+        self.solver.finger.place(0.0, 1.0, 0, dx, |_| 0.0);
+        self.solver.finger.set_law(
+            0.0,
+            0.0,
+            self.config.time_step_s,
+            self.config.string.linear_density_kg_m,
+        );
+        self.external_work_j += self.energy_j() - energy_before;
+        self.refresh_outputs_at_rest_of_motion();
+    }
+
+    /// The seed's "first mode" initial condition: the rest shape plus `amplitude_m` times the
+    /// first mode of the speaking length, released from rest. Allocation-free.
+    pub fn excite_first_mode(&mut self, amplitude_m: f64) {
+        let energy_before = self.energy_j();
+        let start = self.config.speaking_start_m();
+        let length = self.config.string.length_m;
+        let dx = self.operator.spacing_m();
+        for (m, y) in self.displacement.iter_mut().enumerate() {
+            let x = m as f64 * dx;
+            *y = self.rest_displacement[m] + amplitude_m * first_mode_shape(x, start, length);
+        }
+        self.scaled_momentum.fill(0.0);
+        self.external_work_j += self.energy_j() - energy_before;
+        self.refresh_outputs_at_rest_of_motion();
+    }
+
+    fn refresh_outputs_at_rest_of_motion(&mut self) {
+        self.nut_force_n = self.operator.nut_force_n(&self.displacement);
+        self.bridge_force_n = self.static_barrier_force_n(&self.displacement);
+    }
+
+    /// Advances one time step Δt. Allocation-free; never panics.
+    pub fn step(&mut self) {
+        let n = self.config.intervals;
+        let force_scale_twice = 2.0 * self.operator.force_scale();
+        let solver = &mut self.solver;
+        // Constant part of the residual: 2(D yⁿ − d_b − qⁿ) = (Δt²/2ρA)(K yⁿ − b) − 2qⁿ.
+        self.operator
+            .restoring_force(&self.displacement, &mut solver.constant);
+        for m in 1..n {
+            solver.constant[m] =
+                force_scale_twice * solver.constant[m] - 2.0 * self.scaled_momentum[m];
+        }
+        // Contact-free predictor: A s = −constant.
+        for m in 1..n {
+            solver.step[m] = -solver.constant[m];
+        }
+        solver.step[0] = 0.0;
+        solver.step[n] = 0.0;
+        solver.step_factor.solve_in_place(&mut solver.step[1..n]);
+
+        let mut touching = false;
+        let step_vector = &solver.step;
+        for barrier in [&mut solver.bridge, &mut solver.thread, &mut solver.finger] {
+            if barrier.is_active() {
+                barrier.begin_step(&self.displacement);
+                touching |= barrier.touches_during(step_vector);
+            }
+        }
+        let (iterations, converged) = if touching {
+            let outcome = solve_bounded(solver, &self.config.newton);
+            // Forces at the accepted step, for the outputs and the energy ledger.
+            for barrier in [&mut solver.bridge, &mut solver.thread, &mut solver.finger] {
+                if barrier.is_active() {
+                    barrier.evaluate(&solver.step);
+                }
+            }
+            outcome
+        } else {
+            (0, true)
+        };
+        self.stats.record(iterations, converged);
+
+        if self.config.track_energy {
+            let mut loss = self.operator.step_loss_j(&solver.step, &mut self.scratch);
+            if touching {
+                for barrier in [&solver.bridge, &solver.thread] {
+                    if barrier.is_active() {
+                        loss += barrier.step_loss_j(self.config.time_step_s);
+                    }
+                }
+            }
+            self.cumulative_losses_j += loss;
+        }
+
+        let mut finite = true;
+        for m in 1..n {
+            let s = solver.step[m];
+            self.displacement[m] += s;
+            self.scaled_momentum[m] = s - self.scaled_momentum[m];
+            finite &= s.is_finite();
+        }
+
+        let dt = self.config.time_step_s;
+        let density = self.config.string.linear_density_kg_m;
+        self.nut_force_n = self.operator.nut_force_n(&self.displacement);
+        if touching {
+            self.bridge_force_n =
+                solver.bridge.total_force_n(dt, density) + solver.thread.total_force_n(dt, density);
+            self.max_penetration_m = solver
+                .bridge
+                .max_penetration_after_step_m()
+                .max(solver.thread.max_penetration_after_step_m());
+        } else {
+            self.bridge_force_n = 0.0;
+            self.max_penetration_m = 0.0;
+        }
+        if !finite || !self.nut_force_n.is_finite() {
+            // Fail soft: a non-finite state cannot recover, so silence the string at rest.
+            self.non_finite_resets += 1;
+            self.displacement.copy_from_slice(&self.rest_displacement);
+            self.scaled_momentum.fill(0.0);
+            self.nut_force_n = self.rest_nut_force_n;
+            self.bridge_force_n = self.rest_bridge_force_n;
+        }
+    }
+
+    /// The discrete energy H (eq. 8–9) of the current state, J.
+    pub fn energy_j(&self) -> f64 {
+        let mut energy = self.operator.potential_energy_j(&self.displacement)
+            + self.operator.kinetic_energy_j(&self.scaled_momentum);
+        for barrier in [&self.solver.bridge, &self.solver.thread] {
+            if barrier.is_active() {
+                energy += barrier.potential_energy_j(&self.displacement);
+            }
+        }
+        energy
+    }
+
+    /// H at the rest state, J: what a silent string holds (tension over the bridge).
+    pub fn rest_energy_j(&self) -> f64 {
+        let mut energy = self.operator.potential_energy_j(&self.rest_displacement);
+        for barrier in [&self.solver.bridge, &self.solver.thread] {
+            if barrier.is_active() {
+                energy += barrier.potential_energy_j(&self.rest_displacement);
+            }
+        }
+        energy
+    }
+
+    /// The force on the nut after the last step (eq. 13), N.
+    pub fn nut_force_n(&self) -> f64 {
+        self.nut_force_n
+    }
+
+    /// The total force of bridge and thread on the string over the last step (eq. 12), N.
+    pub fn bridge_force_n(&self) -> f64 {
+        self.bridge_force_n
+    }
+
+    /// The nut force at rest, N (subtract it for an audio signal without DC).
+    pub fn rest_nut_force_n(&self) -> f64 {
+        self.rest_nut_force_n
+    }
+
+    /// The bridge force at rest, N.
+    pub fn rest_bridge_force_n(&self) -> f64 {
+        self.rest_bridge_force_n
+    }
+
+    /// Energy dissipated since the last reset (γ, η, r_b, r_c), J. Booked only when
+    /// `track_energy` is on.
+    pub fn cumulative_losses_j(&self) -> f64 {
+        self.cumulative_losses_j
+    }
+
+    /// Energy added by plucks since the last reset, J.
+    pub fn external_work_j(&self) -> f64 {
+        self.external_work_j
+    }
+
+    pub fn newton_stats(&self) -> &NewtonStats {
+        &self.stats
+    }
+
+    /// Deepest penetration into bridge or thread after the last step, m.
+    pub fn max_penetration_m(&self) -> f64 {
+        self.max_penetration_m
+    }
+
+    /// Static solves (rest state or pluck) that hit their cap; 0 in normal operation.
+    pub fn static_solve_failures(&self) -> u64 {
+        self.static_solve_failures
+    }
+
+    /// Steps whose state became non-finite and were reset to rest; 0 in normal operation.
+    pub fn non_finite_resets(&self) -> u64 {
+        self.non_finite_resets
+    }
+
+    /// y on the full grid (nodes 0..=N), m.
+    pub fn displacement_m(&self) -> &[f64] {
+        &self.displacement
+    }
+
+    /// The rest shape on the full grid, m.
+    pub fn rest_displacement_m(&self) -> &[f64] {
+        &self.rest_displacement
+    }
+
+    pub fn config(&self) -> &TanpuraStringConfig {
+        &self.config
+    }
+
+    pub fn operator(&self) -> &StringOperator {
+        &self.operator
+    }
+
+    /// The bridge's points and heights, m (for plotting the contact region).
+    pub fn bridge_grid(&self) -> &BarrierGrid {
+        &self.solver.bridge
+    }
+
+    /// The thread's points and heights, m (empty without a thread).
+    pub fn thread_grid(&self) -> &BarrierGrid {
+        &self.solver.thread
+    }
+
+    /// The vibrational energy above the rest state, J (used to decide when a string sleeps).
+    pub fn vibration_energy_j(&self) -> f64 {
+        self.energy_j() - self.rest_energy_j()
+    }
+
+    /// Puts a decayed string exactly at rest (the sleeping state), keeping the ledgers.
+    pub fn settle_to_rest(&mut self) {
+        let energy_before = self.energy_j();
+        self.displacement.copy_from_slice(&self.rest_displacement);
+        self.scaled_momentum.fill(0.0);
+        self.external_work_j += self.energy_j() - energy_before;
+        self.nut_force_n = self.rest_nut_force_n;
+        self.bridge_force_n = self.rest_bridge_force_n;
+        self.max_penetration_m = 0.0;
+    }
+}
+
+/// Points of a grid covering `[start, end]` with the given spacing (at least one).
+fn grid_points(start_m: f64, end_m: f64, spacing_m: f64) -> usize {
+    ((end_m - start_m) / spacing_m).floor().max(0.0) as usize + 1
+}
+
+/// Cubic Lagrange interpolation of a full-node vector at a position in grid units.
+fn interpolate_full(values: &[f64], position_in_intervals: f64) -> f64 {
+    let intervals = values.len() - 1;
+    let (first, weights) = crate::barrier_grid::lagrange_stencil(position_in_intervals, intervals);
+    (0..4).map(|j| weights[j] * values[first + j]).sum()
+}
