@@ -7,6 +7,7 @@
 pub mod bowed;
 pub mod stability;
 
+pub mod analysis;
 pub mod banded;
 pub mod barrier_grid;
 pub mod contact;
