@@ -111,6 +111,8 @@ impl SymmetricBanded {
 #[derive(Debug, Clone, PartialEq)]
 pub struct BandedLdlt {
     factors: SymmetricBanded,
+    /// 1/D, so that solves multiply instead of divide.
+    inverse_diagonal: Vec<f64>,
 }
 
 /// The matrix handed to [`BandedLdlt::factorise`] was not positive definite.
@@ -124,6 +126,7 @@ impl BandedLdlt {
     pub fn with_shape(size: usize, half_bandwidth: usize) -> Self {
         Self {
             factors: SymmetricBanded::zeros(size, half_bandwidth),
+            inverse_diagonal: vec![0.0; size],
         }
     }
 
@@ -156,6 +159,7 @@ impl BandedLdlt {
                 return Err(NotPositiveDefinite { row });
             }
             band[row * width] = diagonal;
+            self.inverse_diagonal[row] = 1.0 / diagonal;
         }
         Ok(())
     }
@@ -165,28 +169,35 @@ impl BandedLdlt {
         let size = self.factors.size;
         let w = self.factors.half_bandwidth;
         let width = w + 1;
-        let band = &self.factors.band;
-        // Forward: L z = b.
-        for row in 0..size {
-            let first = row.saturating_sub(w);
+        let band = &self.factors.band[..size * width];
+        let solution = &mut solution[..size];
+        // Forward: L z = b. Row r of `band` holds L[r][r−1..r−w] at offsets 1..=w.
+        for (row, entries) in band.chunks_exact(width).enumerate() {
+            let reach = w.min(row);
             let mut value = solution[row];
-            for k in first..row {
-                value -= band[row * width + (row - k)] * solution[k];
+            for (l, x) in entries[1..=reach]
+                .iter()
+                .zip(solution[row - reach..row].iter().rev())
+            {
+                value -= l * x;
             }
             solution[row] = value;
         }
         // Diagonal: D u = z.
-        for row in 0..size {
-            solution[row] /= band[row * width];
+        for (x, inverse) in solution.iter_mut().zip(&self.inverse_diagonal) {
+            *x *= inverse;
         }
-        // Backward: Lᵀ x = u.
-        for row in (0..size).rev() {
-            let last = (row + w).min(size - 1);
-            let mut value = solution[row];
-            for k in row + 1..=last {
-                value -= band[k * width + (k - row)] * solution[k];
+        // Backward: Lᵀ x = u, as column sweeps: once x[row] is final, remove it from the rows
+        // above that it couples to.
+        for (row, entries) in band.chunks_exact(width).enumerate().rev() {
+            let reach = w.min(row);
+            let x = solution[row];
+            for (l, target) in entries[1..=reach]
+                .iter()
+                .zip(solution[row - reach..row].iter_mut().rev())
+            {
+                *target -= l * x;
             }
-            solution[row] = value;
         }
     }
 }

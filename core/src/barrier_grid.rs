@@ -38,6 +38,11 @@ pub struct BarrierGrid {
     forces: Vec<f64>,
     jacobian: Vec<f64>,
     squared_gap_changes: Vec<f64>,
+    /// Points that may touch during the current step (see [`BarrierGrid::begin_step`]).
+    candidates: Vec<usize>,
+    candidate_count: usize,
+    /// max_i Σ_j |w_ij|: bounds |s̃_i| ≤ lebesgue · max_m |s_m| over the stencil nodes.
+    lebesgue: f64,
 }
 
 /// Cubic Lagrange weights on the nodes `first..first + 4` for the point `x` (in units of Δx).
@@ -79,6 +84,9 @@ impl BarrierGrid {
             forces: vec![0.0; capacity],
             jacobian: vec![0.0; capacity],
             squared_gap_changes: vec![0.0; capacity],
+            candidates: vec![0; capacity],
+            candidate_count: 0,
+            lebesgue: 1.0,
         }
     }
 
@@ -100,6 +108,8 @@ impl BarrierGrid {
         self.count = count;
         self.spacing_m = spacing_m;
         self.transpose_scale = spacing_m / string_spacing_m;
+        self.lebesgue = 1.0;
+        self.candidate_count = 0;
         for i in 0..count {
             let x = first_m + i as f64 * spacing_m;
             self.positions_m[i] = x;
@@ -107,7 +117,25 @@ impl BarrierGrid {
             let (first, weights) = lagrange_stencil(x / string_spacing_m, self.string_intervals);
             self.stencil_first_node[i] = first;
             self.stencil_weights[i] = weights;
+            self.lebesgue = self
+                .lebesgue
+                .max(weights.iter().map(|w| w.abs()).sum::<f64>());
         }
+    }
+
+    /// The nodes `first..=last` that this barrier's stencils reach (None when empty).
+    pub fn stencil_node_range(&self) -> Option<(usize, usize)> {
+        if self.count == 0 {
+            return None;
+        }
+        let first = self.stencil_first_node[..self.count].iter().min()?;
+        let last = self.stencil_first_node[..self.count].iter().max()? + 3;
+        Some((*first, last))
+    }
+
+    /// max_i Σ_j |w_ij| of the placed points (≥ 1; 1.25 at most for cubic Lagrange).
+    pub fn lebesgue_constant(&self) -> f64 {
+        self.lebesgue
     }
 
     /// Moves the whole barrier up by `offset_m` (a rigid finger rising). Allocation-free.
@@ -171,17 +199,40 @@ impl BarrierGrid {
             + w[3] * values[first + 3]
     }
 
-    /// Records the gaps `a_i = y_barrier(x_i) − ỹ_i` for the displacement before the step.
-    pub fn begin_step(&mut self, displacement: &[f64]) {
+    /// Records the gaps `a_i = y_barrier(x_i) − ỹ_i` for the displacement before the step and
+    /// selects as candidates the points with `a_i > −margin_m`. A point outside the candidates
+    /// stays out of contact for any step with `|s̃_i| < margin_m`, so the caller must check
+    /// that bound on its accepted step ([`BarrierGrid::lebesgue_constant`]) or pass an infinite
+    /// margin.
+    pub fn begin_step(&mut self, displacement: &[f64], margin_m: f64) {
+        self.candidate_count = 0;
         for i in 0..self.count {
-            self.gaps_m[i] = self.heights_m[i] - self.interpolate(displacement, i);
+            let gap = self.heights_m[i] - self.interpolate(displacement, i);
+            self.gaps_m[i] = gap;
+            if gap > -margin_m {
+                self.candidates[self.candidate_count] = i;
+                self.candidate_count += 1;
+                self.forces[i] = 0.0;
+                self.steps_m[i] = 0.0;
+                self.jacobian[i] = 0.0;
+                self.squared_gap_changes[i] = 0.0;
+            }
         }
+    }
+
+    fn candidate_indices(&self) -> &[usize] {
+        &self.candidates[..self.candidate_count]
+    }
+
+    /// How many points may touch during this step.
+    pub fn candidate_count(&self) -> usize {
+        self.candidate_count
     }
 
     /// Whether any point can be in contact during the step `step` (full-node vector): a point
     /// exerts a force only if its gap is positive before or after the step.
     pub fn touches_during(&self, step: &[f64]) -> bool {
-        (0..self.count).any(|i| {
+        self.candidate_indices().iter().any(|&i| {
             let gap = self.gaps_m[i];
             gap > 0.0 || gap - self.interpolate(step, i) > 0.0
         })
@@ -189,7 +240,8 @@ impl BarrierGrid {
 
     /// Evaluates the mid-point forces and Jacobian entries for the step `step`.
     pub fn evaluate(&mut self, step: &[f64]) {
-        for i in 0..self.count {
+        for index in 0..self.candidate_count {
+            let i = self.candidates[index];
             let point_step = self.interpolate(step, i);
             let contact = self.law.midpoint_force(self.gaps_m[i], point_step);
             self.steps_m[i] = point_step;
@@ -202,7 +254,7 @@ impl BarrierGrid {
     /// Adds `I* f̃` (scaled forces on the string nodes) into the full-node vector `output`.
     pub fn spread_forces(&self, output: &mut [f64]) {
         let last_free = self.string_intervals - 1;
-        for i in 0..self.count {
+        for &i in self.candidate_indices() {
             let force = self.transpose_scale * self.forces[i];
             if force == 0.0 {
                 continue;
@@ -220,7 +272,7 @@ impl BarrierGrid {
     /// Adds `I* C I` into `jacobian`, whose row r is string node r + 1.
     pub fn add_jacobian(&self, jacobian: &mut SymmetricBanded) {
         let last_free = self.string_intervals - 1;
-        for i in 0..self.count {
+        for &i in self.candidate_indices() {
             let stiffness = self.transpose_scale * self.jacobian[i];
             if stiffness == 0.0 {
                 continue;
@@ -243,9 +295,38 @@ impl BarrierGrid {
         }
     }
 
+    /// Adds the block of `I* C I` on nodes `first_node..first_node + size` into the dense
+    /// row-major `size × size` matrix `dense` (every stencil must lie inside that block).
+    pub fn add_jacobian_dense(&self, dense: &mut [f64], size: usize, first_node: usize) {
+        let last_free = self.string_intervals - 1;
+        for &i in self.candidate_indices() {
+            let stiffness = self.transpose_scale * self.jacobian[i];
+            if stiffness == 0.0 {
+                continue;
+            }
+            let first = self.stencil_first_node[i];
+            let w = &self.stencil_weights[i];
+            for j in 0..4 {
+                let row_node = first + j;
+                if !(1..=last_free).contains(&row_node) {
+                    continue;
+                }
+                let row = row_node - first_node;
+                for k in 0..4 {
+                    let column_node = first + k;
+                    if (1..=last_free).contains(&column_node) {
+                        dense[row * size + column_node - first_node] += stiffness * w[j] * w[k];
+                    }
+                }
+            }
+        }
+    }
+
     /// Whether the last [`evaluate`](Self::evaluate) found any point exerting a force.
     pub fn has_force(&self) -> bool {
-        self.forces[..self.count].iter().any(|&f| f != 0.0)
+        self.candidate_indices()
+            .iter()
+            .any(|&i| self.forces[i] != 0.0)
     }
 
     /// The barrier's potential energy `Δx_b Σ k/2 ⌊a_i⌋²` (J) for a displacement.
@@ -262,8 +343,10 @@ impl BarrierGrid {
     /// Energy (J) dissipated by the contact damping r over the last evaluated step:
     /// `Δx_b Σ −(r/Δt)(k/2) Φ_i s̃_i ≥ 0`.
     pub fn step_loss_j(&self, time_step_s: f64) -> f64 {
-        let sum: f64 = (0..self.count)
-            .map(|i| -self.squared_gap_changes[i] * self.steps_m[i])
+        let sum: f64 = self
+            .candidate_indices()
+            .iter()
+            .map(|&i| -self.squared_gap_changes[i] * self.steps_m[i])
             .sum();
         self.spacing_m * self.damping_s_m * 0.5 * self.stiffness_n_m2 * sum / time_step_s
     }
@@ -271,25 +354,20 @@ impl BarrierGrid {
     /// The total force on the barrier over the last evaluated step (eq. 12), N:
     /// `Δx_b Σ F_i` with the physical density `F_i = f̃_i · 2ρA/Δt²`.
     pub fn total_force_n(&self, time_step_s: f64, linear_density_kg_m: f64) -> f64 {
-        let sum: f64 = self.forces[..self.count].iter().sum();
+        let sum: f64 = self
+            .candidate_indices()
+            .iter()
+            .map(|&i| self.forces[i])
+            .sum();
         self.spacing_m * sum * 2.0 * linear_density_kg_m / (time_step_s * time_step_s)
     }
 
     /// The deepest penetration after the last evaluated step, m (0 when nothing touches).
     pub fn max_penetration_after_step_m(&self) -> f64 {
-        (0..self.count)
-            .map(|i| self.gaps_m[i] - self.steps_m[i])
+        self.candidate_indices()
+            .iter()
+            .map(|&i| self.gaps_m[i] - self.steps_m[i])
             .fold(0.0, f64::max)
-    }
-
-    /// Forgets the last step's forces (used when a step needs no contact evaluation).
-    pub fn clear_step(&mut self) {
-        for i in 0..self.count {
-            self.steps_m[i] = 0.0;
-            self.forces[i] = 0.0;
-            self.jacobian[i] = 0.0;
-            self.squared_gap_changes[i] = 0.0;
-        }
     }
 
     /// Static contact at displacement `y`: adds the spring force `I* k⌊a⌋` (N/m) into
@@ -370,7 +448,7 @@ mod tests {
         grid.place(0.05, 0.0037, 40, dx, |x| 1e-4 * (x * 50.0).sin());
         grid.set_law(1e8, 0.0, 1e-5, 5e-4);
         let displacement = vec![0.0; intervals + 1];
-        grid.begin_step(&displacement);
+        grid.begin_step(&displacement, f64::INFINITY);
         let mut step: Vec<f64> = (0..=intervals)
             .map(|m| -2e-4 * (m as f64 * 0.3).cos())
             .collect();

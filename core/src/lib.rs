@@ -10,6 +10,7 @@ pub mod stability;
 pub mod analysis;
 pub mod banded;
 pub mod barrier_grid;
+pub mod condensed;
 pub mod contact;
 pub mod decimator;
 pub mod excitation;

@@ -26,7 +26,8 @@
 //! `H(n) + cumulative losses − external work = H(0)` to round-off.
 
 use crate::banded::{BandedLdlt, SymmetricBanded};
-use crate::barrier_grid::BarrierGrid;
+use crate::barrier_grid::{lagrange_stencil, BarrierGrid};
+use crate::condensed::ContactCondensation;
 use crate::excitation::{finger_height_m, first_mode_shape, Pluck};
 use crate::newton::{solve_bounded, NewtonSettings, NewtonStats, NewtonSystem};
 use crate::string_operator::{StringOperator, StringParameters};
@@ -129,6 +130,17 @@ impl FingerSettings {
     };
 }
 
+/// How the Newton iteration of each step is solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SolverKind {
+    /// Newton on all N − 1 unknowns with a banded LDLᵀ Jacobian: the plain reference path.
+    FullNewton,
+    /// The same Newton iterates on the contact region only, through the precomputed Schur
+    /// complement of the linear part (`condensed.rs`), and only for barrier points that can
+    /// touch during the step.
+    Condensed,
+}
+
 /// Everything that defines one simulated string.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TanpuraStringConfig {
@@ -142,6 +154,7 @@ pub struct TanpuraStringConfig {
     pub thread: Option<ThreadSettings>,
     pub finger: FingerSettings,
     pub newton: NewtonSettings,
+    pub solver: SolverKind,
     /// Book the losses of every step (costs a few O(N) passes; tests and research tools).
     pub track_energy: bool,
 }
@@ -156,6 +169,7 @@ impl TanpuraStringConfig {
         thread: Some(ThreadSettings::SEED),
         finger: FingerSettings::SEED,
         newton: NewtonSettings::REFERENCE,
+        solver: SolverKind::Condensed,
         track_energy: false,
     };
 
@@ -190,6 +204,8 @@ const MAX_FINGER_WIDTH_M: f64 = 0.040;
 /// Static equilibrium: Newton on a piecewise-linear problem ends once the contact set settles.
 const STATIC_MAX_ITERATIONS: u32 = 100;
 const STATIC_TOLERANCE_M: f64 = 1e-16;
+/// Smallest candidate margin, m: keeps points at round-off distance from contact in play.
+const CANDIDATE_MARGIN_FLOOR_M: f64 = 1e-12;
 
 /// The per-step solver state: the linear step matrix, the Jacobian and the barriers.
 #[derive(Debug, Clone)]
@@ -210,10 +226,35 @@ struct StepSolver {
     bridge: BarrierGrid,
     thread: BarrierGrid,
     finger: BarrierGrid,
+    kind: SolverKind,
+    /// The contact region's Schur complement (None when no barrier can ever touch).
+    condensation: Option<ContactCondensation>,
+}
+
+impl StepSolver {
+    /// One Newton update on the contact region only (see `condensed.rs`).
+    fn condensed_update(&mut self) -> Option<f64> {
+        let condensation = self.condensation.as_mut()?;
+        let first = condensation.first_node();
+        let size = condensation.size();
+        self.contact[first..first + size].fill(0.0);
+        let jacobian = condensation.jacobian_reset_to_schur();
+        for barrier in [&mut self.bridge, &mut self.thread] {
+            if barrier.is_active() {
+                barrier.evaluate(&self.step);
+                barrier.spread_forces(&mut self.contact);
+                barrier.add_jacobian_dense(jacobian, size, first);
+            }
+        }
+        condensation.update(&mut self.step, &self.contact)
+    }
 }
 
 impl NewtonSystem for StepSolver {
     fn newton_update(&mut self) -> Option<f64> {
+        if self.kind == SolverKind::Condensed && self.condensation.is_some() {
+            return self.condensed_update();
+        }
         let n = self.intervals;
         self.contact.fill(0.0);
         self.jacobian.copy_from(&self.step_matrix);
@@ -296,6 +337,9 @@ impl TanpuraString {
             bridge: BarrierGrid::with_capacity(bridge_capacity, n),
             thread: BarrierGrid::with_capacity(thread_capacity, n),
             finger: BarrierGrid::with_capacity(finger_capacity, n),
+            kind: config.solver,
+            condensation: contact_node_range(&config, operator.spacing_m())
+                .map(|(first, last)| ContactCondensation::new(first, last, n - 1)),
         };
         let mut string = Self {
             config,
@@ -362,6 +406,12 @@ impl TanpuraString {
             .step_factor
             .factorise(&self.solver.step_matrix)
             .expect("the string's step matrix is positive definite for positive T, EI, ρA");
+        self.solver.kind = config.solver;
+        if let Some(condensation) = &mut self.solver.condensation {
+            condensation
+                .prepare(&self.solver.step_factor, &mut self.scratch)
+                .expect("a principal block of A⁻¹ is positive definite");
+        }
         let dx = self.operator.spacing_m();
 
         let bridge = config.bridge;
@@ -606,24 +656,71 @@ impl TanpuraString {
         solver.step[n] = 0.0;
         solver.step_factor.solve_in_place(&mut solver.step[1..n]);
 
+        // Points farther from contact than any step can reach are left out of the Newton
+        // iteration; the bound is checked on the accepted step below.
+        let condensed = solver.kind == SolverKind::Condensed && solver.condensation.is_some();
+        let lebesgue = solver
+            .bridge
+            .lebesgue_constant()
+            .max(solver.thread.lebesgue_constant());
+        let margin = match &mut solver.condensation {
+            Some(condensation) if condensed => {
+                condensation.set_predictor(&solver.step);
+                2.0 * lebesgue * condensation.predictor_max_abs() + CANDIDATE_MARGIN_FLOOR_M
+            }
+            _ => f64::INFINITY,
+        };
         let mut touching = false;
-        let step_vector = &solver.step;
-        for barrier in [&mut solver.bridge, &mut solver.thread, &mut solver.finger] {
+        for barrier in [&mut solver.bridge, &mut solver.thread] {
             if barrier.is_active() {
-                barrier.begin_step(&self.displacement);
-                touching |= barrier.touches_during(step_vector);
+                barrier.begin_step(&self.displacement, margin);
+                touching |= barrier.touches_during(&solver.step);
+            }
+        }
+        if condensed && touching {
+            if let Some(condensation) = &solver.condensation {
+                condensation.apply_initial_guess(&mut solver.step);
             }
         }
         let (iterations, converged) = if touching {
-            let outcome = solve_bounded(solver, &self.config.newton);
-            // Forces at the accepted step, for the outputs and the energy ledger.
-            for barrier in [&mut solver.bridge, &mut solver.thread, &mut solver.finger] {
-                if barrier.is_active() {
-                    barrier.evaluate(&solver.step);
+            let mut outcome = solve_bounded(solver, &self.config.newton);
+            if condensed {
+                let reach = lebesgue * max_abs_on(&solver.step, solver.condensation.as_ref());
+                if reach >= margin {
+                    // The step went farther than the candidate margin: redo with every point.
+                    for barrier in [&mut solver.bridge, &mut solver.thread] {
+                        if barrier.is_active() {
+                            barrier.begin_step(&self.displacement, f64::INFINITY);
+                        }
+                    }
+                    let again = solve_bounded(solver, &self.config.newton);
+                    outcome = (outcome.0 + again.0, again.1);
+                }
+                // Recover the whole step: s = s_lin + A⁻¹ Σ I* f̃.
+                let condensation = solver.condensation.as_mut().expect("condensed");
+                let first = condensation.first_node();
+                let size = condensation.size();
+                solver.contact[first..first + size].fill(0.0);
+                for barrier in [&mut solver.bridge, &mut solver.thread] {
+                    if barrier.is_active() {
+                        barrier.evaluate(&solver.step);
+                        barrier.spread_forces(&mut solver.contact);
+                    }
+                }
+                condensation.recover_step(&mut solver.step, &solver.contact);
+            } else {
+                // Forces at the accepted step, for the outputs and the energy ledger.
+                for barrier in [&mut solver.bridge, &mut solver.thread] {
+                    if barrier.is_active() {
+                        barrier.evaluate(&solver.step);
+                    }
                 }
             }
             outcome
         } else {
+            if let Some(condensation) = &mut solver.condensation {
+                condensation.clear_correction();
+            }
             (0, true)
         };
         self.stats.record(iterations, converged);
@@ -848,6 +945,37 @@ impl TanpuraString {
         self.bridge_force_n = self.rest_bridge_force_n;
         self.max_penetration_m = 0.0;
     }
+}
+
+/// The largest |s| on the contact block (or on the whole string without one).
+fn max_abs_on(step: &[f64], condensation: Option<&ContactCondensation>) -> f64 {
+    let block = match condensation {
+        Some(condensation) => {
+            &step[condensation.first_node()..condensation.first_node() + condensation.size()]
+        }
+        None => step,
+    };
+    block.iter().fold(0.0, |a, s| a.max(s.abs()))
+}
+
+/// The string nodes that any bridge or thread stencil can reach, for every thread position in
+/// its range: the block the condensed solver iterates on.
+fn contact_node_range(config: &TanpuraStringConfig, spacing_m: f64) -> Option<(usize, usize)> {
+    let n = config.intervals;
+    let thread_reach = ThreadSettings::SEED
+        .half_width_m()
+        .max(config.thread.map_or(0.0, |thread| thread.half_width_m()));
+    let lowest = config
+        .bridge
+        .start_m
+        .min(ThreadSettings::POSITION_RANGE_M.0 - thread_reach);
+    let highest = config
+        .bridge
+        .end_m
+        .max(ThreadSettings::POSITION_RANGE_M.1 + thread_reach);
+    let first = lagrange_stencil(lowest / spacing_m, n).0.max(1);
+    let last = (lagrange_stencil(highest / spacing_m, n).0 + 3).min(n - 1);
+    (first <= last).then_some((first, last))
 }
 
 /// Points of a grid covering `[start, end]` with the given spacing (at least one).
