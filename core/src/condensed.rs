@@ -203,9 +203,7 @@ impl ContactCondensation {
     pub fn recover_step(&mut self, step: &mut [f64], contact: &[f64]) {
         let size = self.size;
         let first = self.first_node;
-        for i in 0..size {
-            step[first + i] = self.predictor[i];
-        }
+        step[first..first + size].copy_from_slice(&self.predictor);
         let forces = &contact[first..first + size];
         for (row, response) in self.response.chunks_exact(size).enumerate() {
             let correction: f64 = response.iter().zip(forces).map(|(g, f)| g * f).sum();

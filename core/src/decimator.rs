@@ -49,7 +49,7 @@ pub fn design_taps(factor: usize) -> Vec<f64> {
     let attenuation = STOPBAND_ATTENUATION_DB;
     let transition = (1.0 - 2.0 * PASSBAND_EDGE) / factor as f64; // Δf / f_in
     let mut count = ((attenuation - 7.95) / (14.36 * transition)).ceil() as usize + 1;
-    if count % 2 == 0 {
+    if count.is_multiple_of(2) {
         count += 1; // odd length: a centre tap, integer group delay
     }
     let beta = 0.1102 * (attenuation - 8.7);

@@ -4,6 +4,11 @@
 //! bowed voice (McIntyre–Schumacher–Woodhouse, Woodhouse 1993; `shared/notes/bowed-model.md`).
 //! SI units throughout.
 
+// Grid equations index nodes m − 1, m, m + 1 of several vectors at once; explicit index loops
+// read like the finite-difference formulas they implement (house style: per-sample code reads
+// like the physics).
+#![allow(clippy::needless_range_loop)]
+
 pub mod bowed;
 pub mod stability;
 

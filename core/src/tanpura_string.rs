@@ -371,7 +371,7 @@ impl TanpuraString {
     /// the new configuration does not fit. The string keeps vibrating; its rest state is
     /// recomputed.
     pub fn set_config(&mut self, config: TanpuraStringConfig) -> bool {
-        let thread_fits = config.thread.map_or(true, |thread| {
+        let thread_fits = config.thread.is_none_or(|thread| {
             grid_points(0.0, 2.0 * thread.half_width_m(), thread.spacing_m)
                 <= self.solver.thread.capacity()
         });

@@ -2,6 +2,8 @@
 //! energy balance to round-off, the linear string's partials and decay, contact depth, the
 //! bounded Newton iteration, determinism, and agreement of the two solvers.
 
+#![allow(clippy::needless_range_loop)]
+
 use javari_core::excitation::Pluck;
 use javari_core::newton::NewtonSettings;
 use javari_core::tanpura_string::{SolverKind, TanpuraString, TanpuraStringConfig};
@@ -91,7 +93,7 @@ fn modal_histories(string: &mut TanpuraString, seconds: f64, rate: f64) -> Vec<V
         })
         .collect();
     let steps = (seconds * rate) as usize;
-    let mut histories = vec![Vec::with_capacity(steps); 10];
+    let mut histories: Vec<Vec<f64>> = (0..10).map(|_| Vec::with_capacity(steps)).collect();
     for _ in 0..steps {
         string.step();
         let y = string.displacement_m();

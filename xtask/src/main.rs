@@ -3,21 +3,24 @@
 //! Each command lives in its own module; this file only dispatches and reports errors.
 
 mod args;
+mod simulate;
 
 use std::process::ExitCode;
 
 const USAGE: &str = "usage: cargo xtask <command> [options]
 
 commands:
-  simulate    probe one tanpura string: CSV of nut force, bridge force, energy, Newton statistics";
+  simulate    probe one tanpura string: CSV of nut force, bridge force, energy, Newton statistics
+              (`cargo xtask simulate --help` lists its options)";
 
 fn main() -> ExitCode {
     let raw: Vec<String> = std::env::args().skip(1).collect();
-    let Some((command, _rest)) = raw.split_first() else {
+    let Some((command, rest)) = raw.split_first() else {
         eprintln!("{USAGE}");
         return ExitCode::from(2);
     };
     let result: Result<(), Box<dyn std::error::Error>> = match command.as_str() {
+        "simulate" => simulate::run(rest),
         "help" | "--help" | "-h" => {
             println!("{USAGE}");
             Ok(())
