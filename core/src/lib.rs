@@ -20,6 +20,7 @@ pub mod contact;
 pub mod decimator;
 pub mod excitation;
 pub mod newton;
+pub mod quality;
 pub mod string_operator;
 pub mod tanpura;
 pub mod tanpura_string;

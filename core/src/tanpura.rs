@@ -1,6 +1,10 @@
 //! The tanpura voice (one string at an oversampled rate, decimated to the output rate) and the
 //! four-string instrument.
 //!
+//! A voice holds one string per quality tier (`quality.rs`), all built up front, so switching
+//! tiers never allocates; only the selected tier's string is computed, and switching starts it
+//! at rest.
+//!
 //! A voice maps musician-facing settings in SI units onto [`TanpuraString`]: the tension follows
 //! the pitch, `T = ρA (2 L_s f)² / (1 + B)` with the speaking length `L_s` from the thread (or the
 //! bridge crest) to the nut and the stiff-string correction `B = π² EI / (T L_s²)` (solved by a
@@ -15,7 +19,8 @@
 
 use crate::decimator::Decimator;
 use crate::excitation::Pluck;
-use crate::newton::{NewtonSettings, NewtonStats};
+use crate::newton::NewtonStats;
+use crate::quality::Quality;
 use crate::string_operator::StringParameters;
 use crate::tanpura_string::{TanpuraString, TanpuraStringConfig, ThreadSettings};
 use std::fmt;
@@ -47,12 +52,8 @@ pub struct VoiceSettings {
     pub eta_s: f64,
     /// Output = w · nut force + (1 − w) · bridge force (0–1).
     pub nut_pickup_weight: f64,
-    /// Internal rate / output rate (1–8; seed 4).
-    pub oversample: usize,
-    /// Newton tolerance, m (1e-15–1e-6).
-    pub newton_tolerance: f64,
-    /// Newton iteration cap (1–100).
-    pub newton_max_iterations: u32,
+    /// Speed against accuracy: oversampling, grids, Newton tolerance and cap (`quality.rs`).
+    pub quality: Quality,
 }
 
 /// The string pitch at which the seed's tension (31.47 N) is reached with the default thread.
@@ -78,9 +79,7 @@ impl Default for VoiceSettings {
             gamma_per_s: StringParameters::SEED.gamma_per_s,
             eta_s: StringParameters::SEED.eta_s,
             nut_pickup_weight: 1.0,
-            oversample: 4,
-            newton_tolerance: NewtonSettings::REFERENCE.tolerance_m,
-            newton_max_iterations: NewtonSettings::REFERENCE.max_iterations,
+            quality: Quality::Reference,
         }
     }
 }
@@ -111,10 +110,8 @@ impl VoiceSettings {
     pub const BRIDGE_STIFFNESS_RANGE: (f64, f64) = (0.0, 1e12);
     pub const GAMMA_RANGE: (f64, f64) = (0.0, 20.0);
     pub const ETA_RANGE: (f64, f64) = (0.0, 1e-6);
-    pub const TOLERANCE_RANGE: (f64, f64) = (1e-15, 1e-6);
-    pub const ITERATION_RANGE: (u32, u32) = (1, 100);
 
-    fn ranges(&self) -> [(&'static str, f64, (f64, f64)); 9] {
+    fn ranges(&self) -> [(&'static str, f64, (f64, f64)); 6] {
         [
             (
                 "fundamental_hz",
@@ -134,24 +131,6 @@ impl VoiceSettings {
             ("gamma_per_s", self.gamma_per_s, Self::GAMMA_RANGE),
             ("eta_s", self.eta_s, Self::ETA_RANGE),
             ("nut_pickup_weight", self.nut_pickup_weight, (0.0, 1.0)),
-            (
-                "oversample",
-                self.oversample as f64,
-                (1.0, MAX_OVERSAMPLE as f64),
-            ),
-            (
-                "newton_tolerance",
-                self.newton_tolerance,
-                Self::TOLERANCE_RANGE,
-            ),
-            (
-                "newton_max_iterations",
-                self.newton_max_iterations as f64,
-                (
-                    Self::ITERATION_RANGE.0 as f64,
-                    Self::ITERATION_RANGE.1 as f64,
-                ),
-            ),
         ]
     }
 
@@ -201,36 +180,46 @@ impl VoiceSettings {
             gamma_per_s: clamp(self.gamma_per_s, Self::GAMMA_RANGE, default.gamma_per_s),
             eta_s: clamp(self.eta_s, Self::ETA_RANGE, default.eta_s),
             nut_pickup_weight: clamp(self.nut_pickup_weight, (0.0, 1.0), 1.0),
-            oversample: self.oversample.clamp(1, MAX_OVERSAMPLE),
-            newton_tolerance: clamp(
-                self.newton_tolerance,
-                Self::TOLERANCE_RANGE,
-                default.newton_tolerance,
-            ),
-            newton_max_iterations: self
-                .newton_max_iterations
-                .clamp(Self::ITERATION_RANGE.0, Self::ITERATION_RANGE.1),
+            quality: self.quality,
         }
     }
 
-    /// The string configuration these settings describe at `output_sample_rate_hz`.
+    /// The string configuration these settings describe at `output_sample_rate_hz`, at the
+    /// settings' own quality tier.
     pub fn string_config(&self, output_sample_rate_hz: f64) -> TanpuraStringConfig {
+        self.string_config_at(self.quality, output_sample_rate_hz)
+    }
+
+    /// The string configuration at a given quality tier.
+    pub fn string_config_at(
+        &self,
+        quality: Quality,
+        output_sample_rate_hz: f64,
+    ) -> TanpuraStringConfig {
+        let tier = quality.tier();
         let mut config = TanpuraStringConfig::REFERENCE;
-        config.time_step_s = 1.0 / (output_sample_rate_hz * self.oversample as f64);
+        config.intervals = tier.intervals;
+        config.time_step_s = 1.0 / (output_sample_rate_hz * tier.oversample as f64);
+        config.bridge.spacing_m *= tier.barrier_spacing_scale;
         config.bridge.stiffness_n_m2 = self.bridge_stiffness_n_m2;
         config.bridge.beyond_thread = self.bridge_beyond_thread;
         config.thread = self.thread_enabled.then_some(ThreadSettings {
             position_m: self.thread_position_m,
+            spacing_m: ThreadSettings::SEED.spacing_m * tier.barrier_spacing_scale,
             ..ThreadSettings::SEED
         });
         config.string.gamma_per_s = self.gamma_per_s;
         config.string.eta_s = self.eta_s;
         config.string.tension_n =
             tension_for_pitch_n(&config, config.speaking_start_m(), self.fundamental_hz);
-        config.newton = NewtonSettings {
-            tolerance_m: self.newton_tolerance,
-            max_iterations: self.newton_max_iterations,
-        };
+        config.string.bending_stiffness_n_m2 = dispersion_compensated_stiffness(
+            &config,
+            quality,
+            self.fundamental_hz,
+            output_sample_rate_hz,
+        );
+        config.newton = tier.newton;
+        config.solver = tier.solver;
         config
     }
 }
@@ -255,14 +244,67 @@ pub fn tension_for_pitch_n(
     tension
 }
 
+/// Relative flattening of partial n, per n², that the scheme's discretisation causes at a
+/// fundamental `fundamental_hz` over the speaking length `speaking_m`: `(πΔx/L_s)²/24` from the
+/// second difference in space and `(2πf₀Δt)²/12` from the trapezoidal rule in time (both
+/// lower the frequencies; the leading terms of their Taylor series).
+fn dispersion_per_n_squared(
+    spacing_m: f64,
+    time_step_s: f64,
+    speaking_m: f64,
+    fundamental_hz: f64,
+) -> f64 {
+    let space = (std::f64::consts::PI * spacing_m / speaking_m).powi(2) / 24.0;
+    let time = (2.0 * std::f64::consts::PI * fundamental_hz * time_step_s).powi(2) / 12.0;
+    space + time
+}
+
+/// The bending stiffness that gives a tier the same n² inharmonicity as the reference tier.
+///
+/// Stiffness raises partial n by `B n²/2` (relative, `B = π² EI/(T L_s²)`), the discretisation
+/// lowers it by `c n²` (see [`dispersion_per_n_squared`]). A coarser tier has a larger `c`; raising
+/// its `B` by `2(c_tier − c_reference)` cancels the difference to leading order, so the first ten
+/// partials of every tier stay close to the reference's. The reference keeps the seed's EI.
+fn dispersion_compensated_stiffness(
+    config: &TanpuraStringConfig,
+    quality: Quality,
+    fundamental_hz: f64,
+    output_sample_rate_hz: f64,
+) -> f64 {
+    let p = config.string;
+    let speaking = p.length_m - config.speaking_start_m();
+    let tier_dispersion = dispersion_per_n_squared(
+        p.length_m / config.intervals as f64,
+        config.time_step_s,
+        speaking,
+        fundamental_hz,
+    );
+    let reference = Quality::Reference.tier();
+    let reference_dispersion = dispersion_per_n_squared(
+        p.length_m / reference.intervals as f64,
+        1.0 / (output_sample_rate_hz * reference.oversample as f64),
+        speaking,
+        fundamental_hz,
+    );
+    if quality == Quality::Reference {
+        return p.bending_stiffness_n_m2;
+    }
+    let pi2 = std::f64::consts::PI.powi(2);
+    let inharmonicity = pi2 * p.bending_stiffness_n_m2 / (p.tension_n * speaking * speaking)
+        + 2.0 * (tier_dispersion - reference_dispersion);
+    inharmonicity * p.tension_n * speaking * speaking / pi2
+}
+
 /// One tanpura string with its oversampling and decimation; allocation-free after `new`.
 #[derive(Debug, Clone)]
 pub struct TanpuraVoice {
     settings: VoiceSettings,
     output_sample_rate_hz: f64,
-    string: TanpuraString,
-    /// One decimator per oversampling factor, built up front so that changing it never
-    /// allocates.
+    /// One string per quality tier, indexed by [`Quality::index`].
+    strings: Vec<TanpuraString>,
+    /// The settings each tier's string was last configured for.
+    configured: Vec<Option<VoiceSettings>>,
+    /// One decimator per oversampling factor, built up front.
     decimators: Vec<Decimator>,
     sleeping: bool,
     /// Output samples of zeros still to push through the decimator after falling asleep.
@@ -271,60 +313,91 @@ pub struct TanpuraVoice {
 }
 
 impl TanpuraVoice {
-    /// A silent voice at rest. Invalid settings are clamped. Allocates.
+    /// A silent voice at rest. Invalid settings are clamped. Allocates every tier's string.
     pub fn new(settings: &VoiceSettings, output_sample_rate_hz: f64) -> Self {
         let settings = settings.clamped();
-        // Built with a thread so that its grid exists if the thread is switched on later.
-        let mut build = settings;
-        build.thread_enabled = true;
-        let string = TanpuraString::new(build.string_config(output_sample_rate_hz));
+        let strings = Quality::ALL
+            .iter()
+            .map(|&quality| {
+                // Built with a thread so that its grid exists if it is switched on later.
+                let mut build = settings;
+                build.thread_enabled = true;
+                TanpuraString::new(build.string_config_at(quality, output_sample_rate_hz))
+            })
+            .collect();
         let decimators = (1..=MAX_OVERSAMPLE).map(Decimator::new).collect();
         let mut voice = Self {
             settings,
             output_sample_rate_hz,
-            string,
+            strings,
+            configured: vec![None; Quality::ALL.len()],
             decimators,
             sleeping: true,
             tail_remaining: 0,
             samples_since_sleep_check: 0,
         };
         voice.configure_string();
-        voice.string.reset();
+        voice.string_mut().reset();
         voice
     }
 
-    /// Configures the string for the settings and tunes it: the tension is scaled until the
-    /// linearised fundamental of the string resting on bridge and thread
+    fn string_mut(&mut self) -> &mut TanpuraString {
+        &mut self.strings[self.settings.quality.index()]
+    }
+
+    /// The string of the selected tier.
+    pub fn string(&self) -> &TanpuraString {
+        &self.strings[self.settings.quality.index()]
+    }
+
+    fn oversample(&self) -> usize {
+        self.settings.quality.tier().oversample
+    }
+
+    /// Configures the selected tier's string for the settings and tunes it: the tension is
+    /// scaled until the linearised fundamental of the string resting on bridge and thread
     /// ([`TanpuraString::linearised_fundamental_hz`]) is the requested pitch. The contact
     /// geometry makes the speaking length differ from "thread to nut" by up to 1 %, which
     /// would be 18 cents; two passes of `T ← T (f / f_lin)²` bring it under 0.1 cent.
     fn configure_string(&mut self) {
-        let mut config = self.settings.string_config(self.output_sample_rate_hz);
-        self.string.set_config(config);
+        let settings = self.settings;
+        let index = settings.quality.index();
+        if self.configured[index] == Some(settings) {
+            return;
+        }
+        let mut config = settings.string_config(self.output_sample_rate_hz);
+        let string = &mut self.strings[index];
+        string.set_config(config);
         for _ in 0..TUNING_PASSES {
-            let linearised = self.string.linearised_fundamental_hz();
+            let linearised = string.linearised_fundamental_hz();
             if !(linearised.is_finite() && linearised > 0.0) {
                 break;
             }
-            let ratio = self.settings.fundamental_hz / linearised;
+            let ratio = settings.fundamental_hz / linearised;
             config.string.tension_n *= ratio * ratio;
-            self.string.set_config(config);
+            string.set_config(config);
         }
+        self.configured[index] = Some(settings);
     }
 
-    /// Applies new settings (clamped) without allocating. The string keeps ringing.
+    /// Applies new settings (clamped) without allocating. The string keeps ringing, unless
+    /// the quality tier changes: the new tier's string then starts at rest.
     pub fn set_settings(&mut self, settings: &VoiceSettings) {
         let settings = settings.clamped();
         if settings == self.settings {
             return;
         }
-        if settings.oversample != self.settings.oversample {
-            self.decimators[settings.oversample - 1].reset();
-        }
+        let tier_changed = settings.quality != self.settings.quality;
         self.settings = settings;
         self.configure_string();
-        if self.sleeping {
-            self.string.settle_to_rest();
+        if tier_changed {
+            let oversample = self.oversample();
+            self.decimators[oversample - 1].reset();
+            self.string_mut().settle_to_rest();
+            self.sleeping = true;
+            self.tail_remaining = 0;
+        } else if self.sleeping {
+            self.string_mut().settle_to_rest();
         }
     }
 
@@ -334,7 +407,7 @@ impl TanpuraVoice {
 
     /// Plucks the string (and wakes it). Allocation-free.
     pub fn pluck(&mut self, pluck: &Pluck) {
-        self.string.pluck(pluck);
+        self.string_mut().pluck(pluck);
         self.sleeping = false;
         self.tail_remaining = 0;
         self.samples_since_sleep_check = 0;
@@ -342,29 +415,32 @@ impl TanpuraVoice {
 
     /// The seed's "first mode" excitation (and wakes the string).
     pub fn excite_first_mode(&mut self, amplitude_m: f64) {
-        self.string.excite_first_mode(amplitude_m);
+        self.string_mut().excite_first_mode(amplitude_m);
         self.sleeping = false;
         self.tail_remaining = 0;
+        self.samples_since_sleep_check = 0;
     }
 
-    fn pickup_n(&self) -> f64 {
+    /// The pickup at the internal rate, N: the nut/bridge mix minus its value at rest.
+    pub fn pickup_internal_n(&self) -> f64 {
+        let string = self.string();
         let w = self.settings.nut_pickup_weight;
-        let nut = self.string.nut_force_n() - self.string.rest_nut_force_n();
-        let bridge = self.string.bridge_force_n() - self.string.rest_bridge_force_n();
+        let nut = string.nut_force_n() - string.rest_nut_force_n();
+        let bridge = string.bridge_force_n() - string.rest_bridge_force_n();
         w * nut + (1.0 - w) * bridge
     }
 
     /// One output-rate sample of the pickup signal, N.
     pub fn next_sample(&mut self) -> f32 {
-        let which = self.settings.oversample - 1;
+        let oversample = self.oversample();
         if self.sleeping {
             if self.tail_remaining == 0 {
                 return 0.0;
             }
             self.tail_remaining -= 1;
-            let decimator = &mut self.decimators[which];
+            let decimator = &mut self.decimators[oversample - 1];
             let mut output = 0.0;
-            for _ in 0..decimator.factor() {
+            for _ in 0..oversample {
                 if let Some(y) = decimator.push(0.0) {
                     output = y;
                 }
@@ -372,21 +448,21 @@ impl TanpuraVoice {
             return output as f32;
         }
         let mut output = 0.0;
-        for _ in 0..self.settings.oversample {
-            self.string.step();
-            let pickup = self.pickup_n();
-            if let Some(y) = self.decimators[which].push(pickup) {
+        for _ in 0..oversample {
+            self.string_mut().step();
+            let pickup = self.pickup_internal_n();
+            if let Some(y) = self.decimators[oversample - 1].push(pickup) {
                 output = y;
             }
         }
         self.samples_since_sleep_check += 1;
         if self.samples_since_sleep_check >= SLEEP_CHECK_INTERVAL {
             self.samples_since_sleep_check = 0;
-            if self.string.vibration_energy_j() < SLEEP_ENERGY_J {
-                self.string.settle_to_rest();
+            if self.string().vibration_energy_j() < SLEEP_ENERGY_J {
+                self.string_mut().settle_to_rest();
                 self.sleeping = true;
-                let decimator = &self.decimators[which];
-                self.tail_remaining = decimator.taps().len() / decimator.factor() + 1;
+                let decimator = &self.decimators[oversample - 1];
+                self.tail_remaining = decimator.taps().len() / oversample + 1;
             }
         }
         output as f32
@@ -404,9 +480,9 @@ impl TanpuraVoice {
         !self.sleeping || self.tail_remaining > 0
     }
 
-    /// Silences the voice: string at rest, decimators cleared, statistics kept.
+    /// Silences the voice: string at rest, decimators cleared.
     pub fn reset(&mut self) {
-        self.string.reset();
+        self.string_mut().reset();
         for decimator in &mut self.decimators {
             decimator.reset();
         }
@@ -414,22 +490,13 @@ impl TanpuraVoice {
         self.tail_remaining = 0;
     }
 
-    /// The current pickup value at the internal rate, N (before decimation).
-    pub fn pickup_internal_n(&self) -> f64 {
-        self.pickup_n()
-    }
-
-    pub fn string(&self) -> &TanpuraString {
-        &self.string
-    }
-
     pub fn newton_stats(&self) -> &NewtonStats {
-        self.string.newton_stats()
+        self.string().newton_stats()
     }
 
     /// Output latency of the decimation filter, samples at the output rate.
     pub fn latency_samples(&self) -> f64 {
-        self.decimators[self.settings.oversample - 1].delay_output_samples()
+        self.decimators[self.oversample() - 1].delay_output_samples()
     }
 }
 

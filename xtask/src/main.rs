@@ -3,6 +3,7 @@
 //! Each command lives in its own module; this file only dispatches and reports errors.
 
 mod args;
+mod bench;
 mod simulate;
 
 use std::process::ExitCode;
@@ -11,7 +12,8 @@ const USAGE: &str = "usage: cargo xtask <command> [options]
 
 commands:
   simulate    probe one tanpura string: CSV of nut force, bridge force, energy, Newton statistics
-              (`cargo xtask simulate --help` lists its options)";
+              (`cargo xtask simulate --help` lists its options)
+  bench       every quality tier on the same scenes: speed, block times, error against reference";
 
 fn main() -> ExitCode {
     let raw: Vec<String> = std::env::args().skip(1).collect();
@@ -21,6 +23,7 @@ fn main() -> ExitCode {
     };
     let result: Result<(), Box<dyn std::error::Error>> = match command.as_str() {
         "simulate" => simulate::run(rest),
+        "bench" => bench::run(rest),
         "help" | "--help" | "-h" => {
             println!("{USAGE}");
             Ok(())

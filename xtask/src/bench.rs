@@ -1,0 +1,396 @@
+//! `cargo xtask bench`: every quality tier on the same scenes, measured in one run.
+//!
+//! For each tier and scene: the real-time factor, the 99.9th-percentile and worst time of a
+//! 64-sample block as a fraction of its deadline, the Newton statistics, and the error against
+//! the reference tier: the largest cents error over the first ten partials, the spectral distance
+//! of the output (RMS difference of third-octave band levels over 40 Hz–16 kHz, in dB, averaged
+//! over frames) and the formant-centre trajectory error (mean relative difference of the
+//! centroid above 5.5 f₀ across the analysis windows). The contact dynamics amplify round-off,
+//! so outputs of different tiers are compared as spectra, never sample by sample.
+//!
+//! Writes a markdown table (`--markdown FILE`, default `bench.md`) and, with `--json FILE`, one
+//! JSON object. A benchmark, not a test: nothing here asserts on time.
+
+use crate::args::Args;
+use javari_core::analysis::{
+    band_power, cents, peak_frequency_hz, power_spectrum, spectral_centroid_hz,
+};
+use javari_core::excitation::Pluck;
+use javari_core::newton::NewtonStats;
+use javari_core::quality::Quality;
+use javari_core::tanpura::{FirstString, Tanpura, TanpuraVoice, VoiceSettings};
+use std::error::Error;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+const SAMPLE_RATE: f64 = 44_100.0;
+const BLOCK: usize = 64;
+
+pub const HELP: &str = "cargo xtask bench [--seconds S] [--markdown FILE] [--json FILE]
+
+  --seconds S      simulated seconds per scene, 1 to 30 (default 3)
+  --markdown FILE  the results table (default bench.md)
+  --json FILE      also write the results as one JSON object";
+
+/// One measured (tier, scene) pair.
+#[derive(Debug, Clone)]
+pub struct BenchResult {
+    pub voice: &'static str,
+    pub tier: &'static str,
+    pub scene: &'static str,
+    pub realtime_factor: f64,
+    pub block_p999: f64,
+    pub block_max: f64,
+    pub newton: NewtonStats,
+    pub cents_error_max: Option<f64>,
+    pub spectral_distance_db: Option<f64>,
+    pub formant_error: Option<f64>,
+    /// The rendered output, kept for the comparison with the reference tier.
+    output: Vec<f64>,
+    fundamental_hz: f64,
+}
+
+/// Something that renders one 64-sample block at a time.
+trait Scene {
+    fn render_block(&mut self, block: &mut [f32], first_sample: usize);
+    fn newton_stats(&self) -> NewtonStats;
+}
+
+struct OneString {
+    voice: TanpuraVoice,
+}
+
+impl Scene for OneString {
+    fn render_block(&mut self, block: &mut [f32], first_sample: usize) {
+        if first_sample == 0 {
+            self.voice.pluck(&Pluck::default());
+        }
+        self.voice.process(block);
+    }
+
+    fn newton_stats(&self) -> NewtonStats {
+        *self.voice.newton_stats()
+    }
+}
+
+/// The classic drone cycle: first string, Sa, Sa, low Sa, one pluck every half second.
+struct Drone {
+    tanpura: Tanpura,
+}
+
+const DRONE_PLUCK_INTERVAL_SAMPLES: usize = 22_050;
+
+impl Scene for Drone {
+    fn render_block(&mut self, block: &mut [f32], first_sample: usize) {
+        for (offset, sample) in block.iter_mut().enumerate() {
+            let index = first_sample + offset;
+            if index.is_multiple_of(DRONE_PLUCK_INTERVAL_SAMPLES) {
+                let string = (index / DRONE_PLUCK_INTERVAL_SAMPLES) % 4;
+                self.tanpura.pluck(string, &Pluck::default());
+            }
+            *sample = self.tanpura.next_sample();
+        }
+    }
+
+    fn newton_stats(&self) -> NewtonStats {
+        self.tanpura.newton_stats()
+    }
+}
+
+fn percentile(sorted: &[f64], fraction: f64) -> f64 {
+    let index = ((sorted.len() as f64 - 1.0) * fraction).round() as usize;
+    sorted[index.min(sorted.len() - 1)]
+}
+
+fn measure(
+    scene: &mut dyn Scene,
+    seconds: f64,
+    voice: &'static str,
+    tier: &'static str,
+    scene_name: &'static str,
+    fundamental_hz: f64,
+) -> BenchResult {
+    let samples = (seconds * SAMPLE_RATE) as usize;
+    let mut output = Vec::with_capacity(samples);
+    let mut block = [0.0f32; BLOCK];
+    let mut block_times = Vec::with_capacity(samples / BLOCK + 1);
+    let deadline = BLOCK as f64 / SAMPLE_RATE;
+    let start = Instant::now();
+    let mut first = 0;
+    while first < samples {
+        let length = BLOCK.min(samples - first);
+        let block_start = Instant::now();
+        scene.render_block(&mut block[..length], first);
+        block_times.push(block_start.elapsed().as_secs_f64() / deadline);
+        output.extend(block[..length].iter().map(|&x| x as f64));
+        first += length;
+    }
+    let elapsed = start.elapsed().as_secs_f64();
+    block_times.sort_by(f64::total_cmp);
+    BenchResult {
+        voice,
+        tier,
+        scene: scene_name,
+        realtime_factor: seconds / elapsed,
+        block_p999: percentile(&block_times, 0.999),
+        block_max: *block_times.last().unwrap_or(&0.0),
+        newton: scene.newton_stats(),
+        cents_error_max: None,
+        spectral_distance_db: None,
+        formant_error: None,
+        output,
+        fundamental_hz,
+    }
+}
+
+/// Frequencies of the first ten partials, from the second half-second onwards.
+fn partials(output: &[f64], fundamental_hz: f64) -> Vec<f64> {
+    let start = (0.5 * SAMPLE_RATE) as usize;
+    let signal = &output[start.min(output.len())..];
+    (1..=10)
+        .map(|n| {
+            let expected = n as f64 * fundamental_hz;
+            peak_frequency_hz(signal, SAMPLE_RATE, expected * 0.97, expected * 1.03)
+        })
+        .collect()
+}
+
+const FRAME: usize = 4096;
+
+/// Third-octave band levels (dB) of each frame, 40 Hz to 16 kHz.
+fn band_levels(output: &[f64]) -> Vec<Vec<f64>> {
+    let bin = SAMPLE_RATE / FRAME as f64;
+    (0..output.len() / FRAME)
+        .map(|frame| {
+            let spectrum = power_spectrum(output, frame * FRAME, FRAME, FRAME);
+            let mut levels = Vec::new();
+            let mut low = 40.0;
+            while low < 16_000.0 {
+                let high = low * 2f64.powf(1.0 / 3.0);
+                levels.push(10.0 * (band_power(&spectrum, bin, low, high) + 1e-30).log10());
+                low = high;
+            }
+            levels
+        })
+        .collect()
+}
+
+/// RMS difference of the third-octave band levels (dB) over bands within 60 dB of the
+/// reference frame's loudest band, averaged over frames: a timbre distance that small pitch
+/// differences do not dominate.
+fn spectral_distance_db(output: &[f64], reference: &[f64]) -> f64 {
+    let (a, b) = (band_levels(output), band_levels(reference));
+    let frames = a.len().min(b.len());
+    let mut total = 0.0;
+    for frame in 0..frames {
+        let floor = b[frame].iter().cloned().fold(f64::MIN, f64::max) - 60.0;
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (x, r) in a[frame].iter().zip(&b[frame]) {
+            if *r > floor {
+                // A band the tier leaves empty counts as the 60 dB it lies below the floor.
+                sum += (x.max(floor) - r).powi(2);
+                count += 1;
+            }
+        }
+        total += (sum / count.max(1) as f64).sqrt();
+    }
+    total / frames.max(1) as f64
+}
+
+fn formant_trajectory(output: &[f64], fundamental_hz: f64) -> Vec<f64> {
+    let bin = SAMPLE_RATE / FRAME as f64;
+    (0..output.len() / FRAME)
+        .map(|frame| {
+            let spectrum = power_spectrum(output, frame * FRAME, FRAME, FRAME);
+            if band_power(&spectrum, bin, 20.0, 20_000.0) == 0.0 {
+                return 0.0;
+            }
+            spectral_centroid_hz(&spectrum, bin, 5.5 * fundamental_hz, 15_000.0)
+        })
+        .collect()
+}
+
+fn compare_with_reference(result: &mut BenchResult, reference: &BenchResult) {
+    let mine = partials(&result.output, result.fundamental_hz);
+    let theirs = partials(&reference.output, reference.fundamental_hz);
+    result.cents_error_max = Some(
+        mine.iter()
+            .zip(&theirs)
+            .map(|(a, b)| cents(*a, *b).abs())
+            .fold(0.0, f64::max),
+    );
+    result.spectral_distance_db = Some(spectral_distance_db(&result.output, &reference.output));
+    let (a, b) = (
+        formant_trajectory(&result.output, result.fundamental_hz),
+        formant_trajectory(&reference.output, reference.fundamental_hz),
+    );
+    let pairs: Vec<(f64, f64)> = a
+        .iter()
+        .zip(&b)
+        .filter(|(_, r)| **r > 0.0)
+        .map(|(x, r)| (*x, *r))
+        .collect();
+    result.formant_error =
+        Some(pairs.iter().map(|(x, r)| (x - r).abs() / r).sum::<f64>() / pairs.len().max(1) as f64);
+}
+
+fn settings_at(quality: Quality) -> VoiceSettings {
+    VoiceSettings {
+        quality,
+        ..VoiceSettings::default()
+    }
+}
+
+/// Runs every tier on every scene and fills in the errors against the reference tier.
+pub fn run_all(seconds: f64) -> Vec<BenchResult> {
+    let mut results = Vec::new();
+    for scene_name in ["one-string", "drone"] {
+        let mut scene_results: Vec<BenchResult> = Quality::ALL
+            .iter()
+            .rev()
+            .map(|&quality| {
+                let settings = settings_at(quality);
+                let sa = settings.fundamental_hz;
+                let mut scene: Box<dyn Scene> = match scene_name {
+                    "one-string" => Box::new(OneString {
+                        voice: TanpuraVoice::new(&settings, SAMPLE_RATE),
+                    }),
+                    _ => {
+                        let mut tanpura = Tanpura::new(&settings, sa, SAMPLE_RATE);
+                        tanpura.set_tuning(&settings, sa, FirstString::Pa);
+                        Box::new(Drone { tanpura })
+                    }
+                };
+                eprintln!("bench: {scene_name}, {} ...", quality.name());
+                measure(
+                    scene.as_mut(),
+                    seconds,
+                    "tanpura",
+                    quality.name(),
+                    scene_name,
+                    sa,
+                )
+            })
+            .collect();
+        let reference = scene_results[0].clone();
+        for result in scene_results.iter_mut().skip(1) {
+            compare_with_reference(result, &reference);
+        }
+        results.extend(scene_results);
+    }
+    results
+}
+
+fn machine_name() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find(|line| line.starts_with("model name"))
+                .and_then(|line| line.split(':').nth(1))
+                .map(|name| name.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    format!("{model}, {cores} cores, {}", std::env::consts::ARCH)
+}
+
+fn json_number(value: Option<f64>) -> String {
+    match value {
+        Some(v) if v.is_finite() => format!("{v:.6}"),
+        _ => "null".into(),
+    }
+}
+
+pub fn to_json(machine: &str, results: &[BenchResult]) -> String {
+    let rows: Vec<String> = results
+        .iter()
+        .map(|r| {
+            format!(
+                "{{\"voice\": \"{}\", \"tier\": \"{}\", \"scene\": \"{}\", \"realtime_factor\": {}, \
+                 \"block_p999\": {}, \"block_max\": {}, \"newton_mean\": {}, \"newton_max\": {}, \
+                 \"cap_hits\": {}, \"cents_error_max\": {}, \"spectral_distance_db\": {}, \
+                 \"formant_error\": {}}}",
+                r.voice,
+                r.tier,
+                r.scene,
+                json_number(Some(r.realtime_factor)),
+                json_number(Some(r.block_p999)),
+                json_number(Some(r.block_max)),
+                json_number(Some(r.newton.mean_iterations())),
+                r.newton.max_iterations,
+                r.newton.cap_hits,
+                json_number(r.cents_error_max),
+                json_number(r.spectral_distance_db),
+                json_number(r.formant_error),
+            )
+        })
+        .collect();
+    format!(
+        "{{\"machine\": \"{}\", \"results\": [\n  {}\n]}}\n",
+        machine.replace('"', "'"),
+        rows.join(",\n  ")
+    )
+}
+
+fn optional(value: Option<f64>, digits: usize) -> String {
+    value.map_or("—".into(), |v| format!("{v:.digits$}"))
+}
+
+pub fn to_markdown(machine: &str, results: &[BenchResult]) -> String {
+    let mut text = format!(
+        "Measured by `cargo xtask bench` on {machine}; 64-sample blocks at 44.1 kHz; errors \
+         against the reference tier of the same scene.\n\n\
+         | voice | scene | tier | real-time factor | block p99.9 | block max | Newton mean / max / cap hits | cents error (10 partials) | spectral distance | formant error |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n"
+    );
+    for r in results {
+        let _ = writeln!(
+            text,
+            "| {} | {} | {} | {:.2}× | {:.1} % | {:.1} % | {:.2} / {} / {} | {} | {} | {} |",
+            r.voice,
+            r.scene,
+            r.tier,
+            r.realtime_factor,
+            100.0 * r.block_p999,
+            100.0 * r.block_max,
+            r.newton.mean_iterations(),
+            r.newton.max_iterations,
+            r.newton.cap_hits,
+            optional(r.cents_error_max, 2),
+            optional(r.spectral_distance_db, 1)
+                + if r.spectral_distance_db.is_some() {
+                    " dB"
+                } else {
+                    ""
+                },
+            optional(r.formant_error.map(|e| 100.0 * e), 1)
+                + if r.formant_error.is_some() { " %" } else { "" },
+        );
+    }
+    text
+}
+
+pub fn run(raw: &[String]) -> Result<(), Box<dyn Error>> {
+    if raw.iter().any(|word| word == "--help" || word == "-h") {
+        println!("{HELP}");
+        return Ok(());
+    }
+    let mut args = Args::parse(raw, &[])?;
+    let seconds = args.number("seconds", 3.0, 1.0, 30.0)?;
+    let markdown = PathBuf::from(args.text("markdown").unwrap_or_else(|| "bench.md".into()));
+    let json = args.text("json").map(PathBuf::from);
+    args.finish()?;
+    let machine = machine_name();
+    let results = run_all(seconds);
+    let table = to_markdown(&machine, &results);
+    print!("{table}");
+    std::fs::write(&markdown, &table)
+        .map_err(|error| format!("cannot write `{}`: {error}", markdown.display()))?;
+    if let Some(path) = json {
+        std::fs::write(&path, to_json(&machine, &results))
+            .map_err(|error| format!("cannot write `{}`: {error}", path.display()))?;
+    }
+    Ok(())
+}
