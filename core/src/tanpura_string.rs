@@ -202,7 +202,7 @@ impl Default for TanpuraStringConfig {
 /// Largest fingertip the finger grid has room for, m.
 const MAX_FINGER_WIDTH_M: f64 = 0.040;
 /// Static equilibrium: Newton on a piecewise-linear problem ends once the contact set settles.
-const STATIC_MAX_ITERATIONS: u32 = 100;
+const STATIC_MAX_ITERATIONS: u32 = 200;
 const STATIC_TOLERANCE_M: f64 = 1e-16;
 /// Smallest candidate margin, m: keeps points at round-off distance from contact in play.
 const CANDIDATE_MARGIN_FLOOR_M: f64 = 1e-12;
@@ -547,19 +547,54 @@ impl TanpuraString {
             solver
                 .jacobian_factor
                 .solve_in_place(&mut solver.residual[..n - 1]);
-            let mut largest = 0.0f64;
-            for m in 1..n {
-                displacement[m] -= solver.residual[m - 1];
-                largest = largest.max(solver.residual[m - 1].abs());
-            }
+            let largest = solver.residual[..n - 1]
+                .iter()
+                .fold(0.0f64, |a, d| a.max(d.abs()));
             if !largest.is_finite() {
                 return false;
             }
             if largest <= STATIC_TOLERANCE_M {
+                for m in 1..n {
+                    displacement[m] -= self.solver.residual[m - 1];
+                }
                 return true;
             }
+            // Backtracking on the static energy, which is convex: the full Newton step can
+            // overshoot when the contact set changes (stiff barriers, coarse grids), a shorter
+            // one cannot fail to decrease it, so the iteration converges from any start.
+            let current = self.static_energy_j(displacement);
+            let mut fraction = 1.0;
+            loop {
+                self.scratch.copy_from_slice(displacement);
+                for m in 1..n {
+                    self.scratch[m] -= fraction * self.solver.residual[m - 1];
+                }
+                let trial = self.static_energy_j(&self.scratch);
+                // Round-off in E near the minimum must not reject a converging step.
+                if trial <= current + 1e-13 * current.abs() || fraction < 1e-6 {
+                    break;
+                }
+                fraction *= 0.5;
+            }
+            displacement.copy_from_slice(&self.scratch);
         }
         false
+    }
+
+    /// The energy whose minimum is the static equilibrium: the string's potential plus every
+    /// active barrier's (the finger's too while it presses), J.
+    fn static_energy_j(&self, displacement: &[f64]) -> f64 {
+        let mut energy = self.operator.potential_energy_j(displacement);
+        for barrier in [
+            &self.solver.bridge,
+            &self.solver.thread,
+            &self.solver.finger,
+        ] {
+            if barrier.is_active() {
+                energy += barrier.potential_energy_j(displacement);
+            }
+        }
+        energy
     }
 
     /// The seed's finger pluck: press the finger (k_f > 0) until the string is in static
