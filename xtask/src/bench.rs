@@ -282,6 +282,104 @@ pub fn run_all(seconds: f64) -> Vec<BenchResult> {
     results
 }
 
+/// What the engine saves by simulating only what a scene needs, on the live tier.
+#[derive(Debug, Clone)]
+pub struct EconomyRow {
+    pub scene: &'static str,
+    pub realtime_factor: f64,
+    pub steps_without_contact: f64,
+    pub note: &'static str,
+}
+
+/// A one-string pluck in the four-string instrument (three strings asleep), a string without
+/// thread, and a string with no barrier at all, each against the plain one-string scene.
+pub fn run_economy(seconds: f64) -> Vec<EconomyRow> {
+    let live = settings_at(Quality::Live);
+    let row = |scene: &mut dyn Scene, name: &'static str, note: &'static str| {
+        let result = measure(scene, seconds, "tanpura", "live", name, live.fundamental_hz);
+        EconomyRow {
+            scene: name,
+            realtime_factor: result.realtime_factor,
+            steps_without_contact: result.newton.steps_without_contact as f64
+                / result.newton.steps.max(1) as f64,
+            note,
+        }
+    };
+    let mut rows = Vec::new();
+    let mut one = OneString {
+        voice: TanpuraVoice::new(&live, SAMPLE_RATE),
+    };
+    rows.push(row(&mut one, "one string", "the baseline"));
+    let mut one_of_four = OneOfFour {
+        tanpura: Tanpura::new(&live, live.fundamental_hz, SAMPLE_RATE),
+    };
+    rows.push(row(
+        &mut one_of_four,
+        "one string of four",
+        "three strings asleep: costs about one string",
+    ));
+    let no_thread = VoiceSettings {
+        thread_enabled: false,
+        ..live
+    };
+    let mut without_thread = OneString {
+        voice: TanpuraVoice::new(&no_thread, SAMPLE_RATE),
+    };
+    rows.push(row(&mut without_thread, "no thread", "no thread grid work"));
+    let free = VoiceSettings {
+        thread_enabled: false,
+        bridge_stiffness_n_m2: 0.0,
+        ..live
+    };
+    let mut free_string = OneString {
+        voice: TanpuraVoice::new(&free, SAMPLE_RATE),
+    };
+    rows.push(row(
+        &mut free_string,
+        "no barrier",
+        "nothing near contact: every step skips Newton",
+    ));
+    rows
+}
+
+/// The four-string instrument with only its Sa string plucked.
+struct OneOfFour {
+    tanpura: Tanpura,
+}
+
+impl Scene for OneOfFour {
+    fn render_block(&mut self, block: &mut [f32], first_sample: usize) {
+        if first_sample == 0 {
+            self.tanpura.pluck(1, &Pluck::default());
+        }
+        for sample in block.iter_mut() {
+            *sample = self.tanpura.next_sample();
+        }
+    }
+
+    fn newton_stats(&self) -> NewtonStats {
+        self.tanpura.newton_stats()
+    }
+}
+
+pub fn economy_markdown(rows: &[EconomyRow]) -> String {
+    let mut text = String::from(
+        "\nSimulating only what the scene needs (live tier):\n\n\
+         | scene | real-time factor | steps without a contact solve | |\n|---|---|---|---|\n",
+    );
+    for row in rows {
+        let _ = writeln!(
+            text,
+            "| {} | {:.2}× | {:.0} % | {} |",
+            row.scene,
+            row.realtime_factor,
+            100.0 * row.steps_without_contact,
+            row.note
+        );
+    }
+    text
+}
+
 fn machine_name() -> String {
     let model = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -303,7 +401,7 @@ fn json_number(value: Option<f64>) -> String {
     }
 }
 
-pub fn to_json(machine: &str, results: &[BenchResult]) -> String {
+pub fn to_json(machine: &str, results: &[BenchResult], economy: &[EconomyRow]) -> String {
     let rows: Vec<String> = results
         .iter()
         .map(|r| {
@@ -327,10 +425,22 @@ pub fn to_json(machine: &str, results: &[BenchResult]) -> String {
             )
         })
         .collect();
+    let economy_rows: Vec<String> = economy
+        .iter()
+        .map(|row| {
+            format!(
+                "{{\"scene\": \"{}\", \"realtime_factor\": {}, \"steps_without_contact\": {}}}",
+                row.scene,
+                json_number(Some(row.realtime_factor)),
+                json_number(Some(row.steps_without_contact)),
+            )
+        })
+        .collect();
     format!(
-        "{{\"machine\": \"{}\", \"results\": [\n  {}\n]}}\n",
+        "{{\"machine\": \"{}\", \"results\": [\n  {}\n], \"economy\": [\n  {}\n]}}\n",
         machine.replace('"', "'"),
-        rows.join(",\n  ")
+        rows.join(",\n  "),
+        economy_rows.join(",\n  ")
     )
 }
 
@@ -384,12 +494,13 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn Error>> {
     args.finish()?;
     let machine = machine_name();
     let results = run_all(seconds);
-    let table = to_markdown(&machine, &results);
+    let economy = run_economy(seconds);
+    let table = to_markdown(&machine, &results) + &economy_markdown(&economy);
     print!("{table}");
     std::fs::write(&markdown, &table)
         .map_err(|error| format!("cannot write `{}`: {error}", markdown.display()))?;
     if let Some(path) = json {
-        std::fs::write(&path, to_json(&machine, &results))
+        std::fs::write(&path, to_json(&machine, &results, &economy))
             .map_err(|error| format!("cannot write `{}`: {error}", path.display()))?;
     }
     Ok(())
