@@ -166,6 +166,15 @@ impl BandedLdlt {
 
     /// Solves `A x = rhs` in place (`solution` holds `rhs` on entry).
     pub fn solve_in_place(&self, solution: &mut [f64]) {
+        if self.factors.half_bandwidth == 2 {
+            self.solve_pentadiagonal(solution);
+        } else {
+            self.solve_general(solution);
+        }
+    }
+
+    /// The plain solve for any bandwidth (the reference for the pentadiagonal fast path).
+    pub fn solve_general(&self, solution: &mut [f64]) {
         let size = self.factors.size;
         let w = self.factors.half_bandwidth;
         let width = w + 1;
@@ -198,6 +207,40 @@ impl BandedLdlt {
             {
                 *target -= l * x;
             }
+        }
+    }
+}
+
+impl BandedLdlt {
+    /// The same solve for half-bandwidth 2 (the string's step matrix, solved every time step),
+    /// with the two previous values carried in registers: the sweeps are a serial dependency
+    /// chain, so loop overhead, not arithmetic, is what costs.
+    fn solve_pentadiagonal(&self, solution: &mut [f64]) {
+        let size = self.factors.size;
+        let band = &self.factors.band[..size * 3];
+        let solution = &mut solution[..size];
+        let (mut previous, mut before_previous) = (0.0, 0.0);
+        for (x, entries) in solution.iter_mut().zip(band.chunks_exact(3)) {
+            let value = *x - entries[1] * previous - entries[2] * before_previous;
+            *x = value;
+            before_previous = previous;
+            previous = value;
+        }
+        for (x, inverse) in solution.iter_mut().zip(&self.inverse_diagonal) {
+            *x *= inverse;
+        }
+        // Backward: x[r] −= L[r+1][r] x[r+1] + L[r+2][r] x[r+2], where L[r+1][r] is row r + 1's
+        // offset-1 entry and L[r+2][r] row r + 2's offset-2 entry: carried up as rows are done.
+        let (mut next, mut after_next) = (0.0, 0.0);
+        let (mut coupling_next, mut coupling_after_next, mut pending_offset_two) = (0.0, 0.0, 0.0);
+        for (row, x) in solution.iter_mut().enumerate().rev() {
+            let value = *x - coupling_next * next - coupling_after_next * after_next;
+            *x = value;
+            after_next = next;
+            next = value;
+            coupling_after_next = pending_offset_two;
+            pending_offset_two = band[row * 3 + 2];
+            coupling_next = band[row * 3 + 1];
         }
     }
 }
@@ -236,6 +279,20 @@ mod tests {
             for (x, e) in rhs.iter().zip(&exact) {
                 assert!((x - e).abs() < 1e-13, "w={w}: {x} vs {e}");
             }
+        }
+    }
+
+    #[test]
+    fn pentadiagonal_fast_path_equals_the_general_solve() {
+        let matrix = test_matrix(57, 2);
+        let mut ldlt = BandedLdlt::with_shape(57, 2);
+        ldlt.factorise(&matrix).unwrap();
+        let rhs: Vec<f64> = (0..57).map(|i| (i as f64 * 1.3).cos()).collect();
+        let (mut fast, mut general) = (rhs.clone(), rhs);
+        ldlt.solve_in_place(&mut fast);
+        ldlt.solve_general(&mut general);
+        for (a, b) in fast.iter().zip(&general) {
+            assert!((a - b).abs() <= 1e-15 * b.abs().max(1.0), "{a} vs {b}");
         }
     }
 
