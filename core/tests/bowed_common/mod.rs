@@ -194,15 +194,28 @@ fn worst(runs: &[usize], target: f64, period_samples: f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Period of a signal from its upward crossings of its mean, linearly interpolated, samples.
-pub fn period_by_crossings(signal: &[f64]) -> f64 {
+/// Period of a sawtooth-like signal, samples: crossings of its mean in the direction of its
+/// steepest edge (the Helmholtz flyback), linearly interpolated, at most one per half of the
+/// nominal period so that ripple near the mean is not counted.
+pub fn period_by_crossings(signal: &[f64], nominal_period: f64) -> f64 {
     let mean = signal.iter().sum::<f64>() / signal.len() as f64;
-    let mut crossings = Vec::new();
+    let steepest = signal
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .fold(0.0_f64, |a, d| if d.abs() > a.abs() { d } else { a });
+    let direction = if steepest < 0.0 { -1.0 } else { 1.0 };
+    let mut crossings: Vec<f64> = Vec::new();
     for i in 1..signal.len() {
-        let a = signal[i - 1] - mean;
-        let b = signal[i] - mean;
+        let a = direction * (signal[i - 1] - mean);
+        let b = direction * (signal[i] - mean);
         if a < 0.0 && b >= 0.0 {
-            crossings.push(i as f64 - 1.0 + a / (a - b));
+            let t = i as f64 - 1.0 + a / (a - b);
+            if crossings
+                .last()
+                .is_none_or(|last| t - last > 0.5 * nominal_period)
+            {
+                crossings.push(t);
+            }
         }
     }
     let n = crossings.len();
@@ -211,4 +224,53 @@ pub fn period_by_crossings(signal: &[f64]) -> f64 {
 
 pub fn cents(measured_period: f64, target_period: f64) -> f64 {
     1200.0 * (target_period / measured_period).log2()
+}
+
+/// Fundamental frequency of `signal` (Hz) near `guess_hz`: the peak of the Hann-windowed
+/// discrete-time Fourier transform, searched on a 0.05-cent grid within ±60 cents and refined
+/// by a parabola through the three highest points.
+pub fn fundamental_hz(signal: &[f64], sample_rate_hz: f64, guess_hz: f64) -> f64 {
+    let n = signal.len();
+    let mean = signal.iter().sum::<f64>() / n as f64;
+    let windowed: Vec<f64> = signal
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            let w = 0.5 - 0.5 * (2.0 * core::f64::consts::PI * i as f64 / (n - 1) as f64).cos();
+            w * (x - mean)
+        })
+        .collect();
+    let power = |cents: f64| {
+        let f = guess_hz * (cents / 1200.0).exp2();
+        let step = 2.0 * core::f64::consts::PI * f / sample_rate_hz;
+        let (mut re, mut im) = (0.0, 0.0);
+        let (sin_step, cos_step) = step.sin_cos();
+        let (mut s, mut c) = (0.0_f64, 1.0_f64);
+        for x in &windowed {
+            re += x * c;
+            im -= x * s;
+            let next_c = c * cos_step - s * sin_step;
+            s = s * cos_step + c * sin_step;
+            c = next_c;
+        }
+        re * re + im * im
+    };
+    let grid = 0.05;
+    let mut best = (-60.0, power(-60.0));
+    let mut k = -60.0 + grid;
+    while k <= 60.0 {
+        let p = power(k);
+        if p > best.1 {
+            best = (k, p);
+        }
+        k += grid;
+    }
+    let (left, right) = (power(best.0 - grid), power(best.0 + grid));
+    let denominator = left - 2.0 * best.1 + right;
+    let offset = if denominator != 0.0 {
+        0.5 * grid * (left - right) / denominator
+    } else {
+        0.0
+    };
+    guess_hz * ((best.0 + offset) / 1200.0).exp2()
 }
