@@ -113,7 +113,7 @@ impl BodyFilter {
         {
             // A resonance at or above Nyquist cannot be represented: keep it just below.
             let nyquist_guard = 0.49 * self.sample_rate_hz;
-            let frequency = resonance.frequency_hz.clamp(1.0, nyquist_guard);
+            let frequency = resonance.frequency_hz.min(nyquist_guard).max(1e-3);
             let omega = 2.0 * core::f64::consts::PI * frequency / self.sample_rate_hz;
             let alpha = omega.sin() / (2.0 * resonance.quality.max(1e-3));
             let a0 = 1.0 + alpha;

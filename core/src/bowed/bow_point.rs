@@ -94,6 +94,16 @@ impl BowPoint {
         bow_force_n: f64,
     ) -> BowPointSolution {
         let a = line_slope_n_s_m;
+        if bow_force_n.is_nan() || bow_force_n <= 0.0 {
+            // Bow lifted: no contact, no force, the string moves freely. The branch memory is
+            // kept for when the bow comes down again.
+            return BowPointSolution {
+                velocity_m_s: free_velocity_m_s,
+                friction_force_n: 0.0,
+                state: ContactState::Slipping,
+                intersections: 1,
+            };
+        }
         let free_relative_m_s = free_velocity_m_s - bow_velocity_m_s;
         let sticking_force_n = -a * free_relative_m_s;
         let sticking_limit_n = law.static_coefficient() * bow_force_n;
@@ -135,8 +145,11 @@ impl BowPoint {
             (_, false, None) => {
                 // Geometrically impossible for a falling law with μ ≥ 0 (the line always meets
                 // the curve), but a user law could be pathological: hold the force at the
-                // sticking limit so the result stays finite and passive.
-                let force = sticking_force_n.clamp(-sticking_limit_n, sticking_limit_n);
+                // sticking limit so the result stays finite and passive. (max/min, not clamp:
+                // clamp panics when a pathological law makes the limit NaN or negative.)
+                let force = sticking_force_n
+                    .min(sticking_limit_n)
+                    .max(-sticking_limit_n);
                 BowPointSolution {
                     velocity_m_s: free_velocity_m_s + force / a,
                     friction_force_n: force,

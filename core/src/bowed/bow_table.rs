@@ -220,8 +220,10 @@ impl BowedVoice for BowTableString {
     /// Clamped to [lowest pitch of the capacity, sample rate / 4]; non-finite is ignored.
     fn set_pitch_hz(&mut self, pitch_hz: f64) {
         if pitch_hz.is_finite() {
-            self.pitch_hz =
-                pitch_hz.clamp(self.capacity.lowest_pitch_hz, 0.25 * self.sample_rate_hz);
+            // min/max, not clamp: a capacity whose lowest pitch exceeds f_s/4 must not panic.
+            self.pitch_hz = pitch_hz
+                .min(0.25 * self.sample_rate_hz)
+                .max(self.capacity.lowest_pitch_hz);
             self.update_delays();
         }
     }

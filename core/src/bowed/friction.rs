@@ -79,7 +79,7 @@ pub fn outer_slip_speed_by_newton<F: FrictionLaw + ?Sized>(
 ) -> Option<f64> {
     let a = line_slope_n_s_m;
     let x = free_slip_speed_m_s;
-    if !(x > 0.0) {
+    if x.is_nan() || x <= 0.0 {
         return None;
     }
     let tolerance = 1e-13 * x.max(1e-9);
@@ -91,12 +91,12 @@ pub fn outer_slip_speed_by_newton<F: FrictionLaw + ?Sized>(
         if residual == 0.0 {
             return Some(w);
         }
-        if !(jacobian > 0.0) {
+        if jacobian.is_nan() || jacobian <= 0.0 {
             return None;
         }
         let step = residual / jacobian;
         w -= step;
-        if !(w > 0.0) {
+        if w.is_nan() || w <= 0.0 {
             return None;
         }
         if step.abs() <= tolerance {
@@ -165,7 +165,7 @@ impl FrictionLaw for HyperbolicFriction {
     ) -> Option<f64> {
         let a = line_slope_n_s_m;
         let x = free_slip_speed_m_s;
-        if !(x > 0.0) {
+        if x.is_nan() || x <= 0.0 {
             return None;
         }
         let v0 = self.decay_velocity_m_s;
