@@ -303,6 +303,27 @@ mod tests {
     }
 
     #[test]
+    fn explicit_sigma_lambda_sigma_taps_convolve_as_in_eq_22() {
+        // Woodhouse's test case: [σ, λ, σ] = [0.05, 0.90, 0.05] (eq. 23: λ + 2σ = 1), applied
+        // with the inverting sign of eq. 22, centred on a 6-sample round trip.
+        let mut r = ReflectionFunction::new(50.0, 8.0);
+        r.set_taps(5, &[-0.05, -0.90, -0.05]);
+        assert_eq!(r.first_tap_delay(), 5);
+        assert!((r.delay_samples() - 6.0).abs() < 1e-12);
+        // A unit outgoing impulse comes back as −σ, −λ, −σ at delays 5, 6, 7.
+        r.push(1.0);
+        let mut echoes = Vec::new();
+        for _ in 1..10 {
+            echoes.push(r.incoming());
+            r.push(0.0);
+        }
+        assert_eq!(
+            echoes,
+            vec![0.0, 0.0, 0.0, 0.0, -0.05, -0.90, -0.05, 0.0, 0.0]
+        );
+    }
+
+    #[test]
     fn delayed_read_interpolates_linearly() {
         let mut r = ReflectionFunction::new(16.0, 2.0);
         for n in 0..10 {
