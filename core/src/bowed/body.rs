@@ -1,0 +1,180 @@
+//! An optional instrument-body filter: a few resonances driven by the bridge force.
+//!
+//! Each resonance is a two-pole band-pass (the constant-peak-gain form of R. Bristow-Johnson's
+//! "Audio EQ Cookbook": b = [α, 0, −α]/(1 + α), a = [1, −2 cos ω, 1 − α]/(1 + α),
+//! α = sin ω / (2Q)), so its gain at the centre frequency is exactly its `gain`. The resonances
+//! run in parallel and their outputs add. This is a deliberately small stand-in for a measured
+//! body response: it colours the bridge force the way the main air and wood modes of a violin do.
+
+/// One body resonance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyResonance {
+    /// Centre frequency, Hz (> 0).
+    pub frequency_hz: f64,
+    /// Quality factor (> 0).
+    pub quality: f64,
+    /// Gain at the centre frequency, in output units per newton of bridge force.
+    pub gain_per_n: f64,
+}
+
+/// Most resonances a body filter holds (fixed storage: no allocation).
+pub const MAX_BODY_RESONANCES: usize = 8;
+
+/// Violin-like modes: the A0 air mode (≈ 275 Hz), the B1− and B1+ corpus modes (≈ 460 and
+/// 550 Hz) and the broad bridge hill (≈ 2.5 kHz), after the values commonly reported in the
+/// violin-acoustics literature (Woodhouse, "The acoustics of the violin: a review", 2014).
+pub const VIOLIN_BODY: [BodyResonance; 4] = [
+    BodyResonance {
+        frequency_hz: 275.0,
+        quality: 15.0,
+        gain_per_n: 1.0,
+    },
+    BodyResonance {
+        frequency_hz: 460.0,
+        quality: 20.0,
+        gain_per_n: 0.8,
+    },
+    BodyResonance {
+        frequency_hz: 550.0,
+        quality: 20.0,
+        gain_per_n: 1.0,
+    },
+    BodyResonance {
+        frequency_hz: 2500.0,
+        quality: 2.0,
+        gain_per_n: 0.6,
+    },
+];
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Biquad {
+    b0: f64,
+    b2: f64,
+    a1: f64,
+    a2: f64,
+    s1: f64,
+    s2: f64,
+}
+
+impl Biquad {
+    #[inline]
+    fn tick(&mut self, x: f64) -> f64 {
+        // Transposed direct form II; b1 = 0 for a band-pass.
+        let y = self.b0 * x + self.s1;
+        self.s1 = -self.a1 * y + self.s2;
+        self.s2 = self.b2 * x - self.a2 * y;
+        y
+    }
+}
+
+/// Parallel bank of body resonances.
+#[derive(Clone, Debug)]
+pub struct BodyFilter {
+    resonances: [BodyResonance; MAX_BODY_RESONANCES],
+    sections: [Biquad; MAX_BODY_RESONANCES],
+    count: usize,
+    sample_rate_hz: f64,
+}
+
+impl BodyFilter {
+    /// A bank with `resonances` (at most [`MAX_BODY_RESONANCES`]; extra ones are ignored).
+    pub fn new(resonances: &[BodyResonance], sample_rate_hz: f64) -> Self {
+        let mut filter = Self {
+            resonances: [BodyResonance {
+                frequency_hz: 1.0,
+                quality: 1.0,
+                gain_per_n: 0.0,
+            }; MAX_BODY_RESONANCES],
+            sections: [Biquad::default(); MAX_BODY_RESONANCES],
+            count: 0,
+            sample_rate_hz,
+        };
+        filter.set_resonances(resonances);
+        filter
+    }
+
+    /// Replace the resonances and recompute coefficients (state is kept).
+    pub fn set_resonances(&mut self, resonances: &[BodyResonance]) {
+        self.count = resonances.len().min(MAX_BODY_RESONANCES);
+        self.resonances[..self.count].copy_from_slice(&resonances[..self.count]);
+        self.update_coefficients();
+    }
+
+    /// Recompute coefficients for a new sample rate.
+    pub fn prepare(&mut self, sample_rate_hz: f64) {
+        self.sample_rate_hz = sample_rate_hz;
+        self.update_coefficients();
+    }
+
+    fn update_coefficients(&mut self) {
+        for (section, resonance) in self.sections[..self.count]
+            .iter_mut()
+            .zip(&self.resonances[..self.count])
+        {
+            // A resonance at or above Nyquist cannot be represented: keep it just below.
+            let nyquist_guard = 0.49 * self.sample_rate_hz;
+            let frequency = resonance.frequency_hz.min(nyquist_guard).max(1e-3);
+            let omega = 2.0 * core::f64::consts::PI * frequency / self.sample_rate_hz;
+            let alpha = omega.sin() / (2.0 * resonance.quality.max(1e-3));
+            let a0 = 1.0 + alpha;
+            section.b0 = resonance.gain_per_n * alpha / a0;
+            section.b2 = -section.b0;
+            section.a1 = -2.0 * omega.cos() / a0;
+            section.a2 = (1.0 - alpha) / a0;
+        }
+    }
+
+    /// Filter one sample of bridge force (N).
+    #[inline]
+    pub fn tick(&mut self, bridge_force_n: f64) -> f64 {
+        let mut sum = 0.0;
+        for section in &mut self.sections[..self.count] {
+            sum += section.tick(bridge_force_n);
+        }
+        sum
+    }
+
+    /// Zero the filter states.
+    pub fn reset(&mut self) {
+        for section in &mut self.sections {
+            section.s1 = 0.0;
+            section.s2 = 0.0;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn steady_gain(filter: &mut BodyFilter, frequency_hz: f64, sample_rate_hz: f64) -> f64 {
+        filter.reset();
+        let n = (sample_rate_hz * 2.0) as usize;
+        let mut peak: f64 = 0.0;
+        for i in 0..n {
+            let x = (2.0 * core::f64::consts::PI * frequency_hz * i as f64 / sample_rate_hz).sin();
+            let y = filter.tick(x);
+            if i > n / 2 {
+                peak = peak.max(y.abs());
+            }
+        }
+        peak
+    }
+
+    #[test]
+    fn single_resonance_has_its_gain_at_centre_and_rejects_far_away() {
+        let sample_rate_hz = 48_000.0;
+        let resonance = BodyResonance {
+            frequency_hz: 500.0,
+            quality: 10.0,
+            gain_per_n: 0.7,
+        };
+        let mut filter = BodyFilter::new(&[resonance], sample_rate_hz);
+        let at_centre = steady_gain(&mut filter, 500.0, sample_rate_hz);
+        assert!((at_centre - 0.7).abs() < 2e-3, "{at_centre}");
+        // Two octaves away a Q = 10 band-pass is down by 1/√(1 + Q²(4 − 1/4)²) ≈ 0.0266.
+        let far = steady_gain(&mut filter, 2000.0, sample_rate_hz);
+        let expected = 0.7 / (1.0 + 100.0 * (3.75f64).powi(2)).sqrt();
+        assert!((far - expected).abs() < 2e-3, "{far} vs {expected}");
+    }
+}

@@ -1,0 +1,333 @@
+//! The cheap tier: the STK bow-table waveguide (seed `004_7bfa60067b967fec.txt`; Smith 1986,
+//! after McIntyre–Schumacher–Woodhouse 1983; Cook & Scavone's STK `Bowed`).
+//!
+//! The bow is a memoryless reflection coefficient of the differential velocity
+//! Δv⁺ = v_b − (i_b + i_n) (bow velocity minus the sum of the incoming waves), seed 004:
+//!
+//! ```text
+//!     BowTable(Δv⁺) = min{ (|Δv⁺| · S + 0.75)^−4, 1 },      S = 5 − 4 · pressure
+//! ```
+//!
+//! and the bow adds Δv⁺ · BowTable(Δv⁺) to both outgoing waves. The plateau |Δv⁺| ≤ 0.25/S,
+//! where the table is 1, is sticking (the string is pulled to the bow velocity); outside it the
+//! string slips. There is no hysteresis, no friction force and no impedance: the velocities are
+//! those of the rounded-corner voice (m/s) so both tiers take the same controls, and the bridge
+//! force is reported as Z₀ (incident − reflected) like the rounded-corner voice's.
+//!
+//! Loop: two fractional delay lines (linear interpolation), bow→nut→bow of D_n and
+//! bow→bridge→bow of D_b, and a loss filter in the bridge reflection with STK's gain 0.95.
+//! STK uses a one-pole low-pass there; this tier uses the symmetric three-tap low-pass
+//! g·[¼, ½, ¼] instead (Woodhouse's [σ, λ, σ] shape of eq. 22), because a one-pole's group
+//! delay falls with frequency, so the sharp Helmholtz corner travels round a shorter loop than
+//! the fundamental: measured with the one-pole, +4.5 cents at 440 Hz / 48 kHz even with its
+//! phase delay at f₀ taken out. The three-tap filter delays every frequency by exactly one
+//! sample; that sample is taken out of the loop and the rest split β : (1 − β).
+//!
+//! Mapping of the physical bow force to STK's normalised pressure:
+//! pressure = clamp(F_b / `full_pressure_force_n`, 0, 1). F_b = 0 lifts the bow: the table is
+//! bypassed and the string rings down.
+
+use super::body::{BodyFilter, BodyResonance, VIOLIN_BODY};
+use super::bowed_string::{StringConstants, BOW_POSITION_RANGE};
+use super::{BowedCapacity, BowedConfigError, BowedOutput, BowedVoice, MIN_SAMPLE_RATE_HZ};
+
+/// STK's slope for a normalised bow pressure in [0, 1]: S = 5 − 4 · pressure (seed 004).
+/// Pressure outside [0, 1] is clamped.
+#[inline]
+pub fn bow_table_slope(pressure: f64) -> f64 {
+    5.0 - 4.0 * pressure.clamp(0.0, 1.0)
+}
+
+/// The bow table of seed 004: min{(|Δv⁺| · S + 0.75)^−4, 1}.
+#[inline]
+pub fn bow_table_reflection(differential_velocity: f64, slope: f64) -> f64 {
+    let base = differential_velocity.abs() * slope + 0.75;
+    let squared = base * base;
+    (1.0 / (squared * squared)).min(1.0)
+}
+
+/// Default force for full STK pressure, N: a firm violin bow stroke.
+pub const DEFAULT_FULL_PRESSURE_FORCE_N: f64 = 2.0;
+
+#[derive(Clone, Debug)]
+struct DelayLine {
+    buffer: Vec<f64>,
+    mask: usize,
+    write: usize,
+}
+
+impl DelayLine {
+    fn new(max_delay_samples: f64) -> Self {
+        let size = (max_delay_samples.max(1.0).ceil() as usize + 3).next_power_of_two();
+        Self {
+            buffer: vec![0.0; size],
+            mask: size - 1,
+            write: 0,
+        }
+    }
+
+    fn max_delay_samples(&self) -> f64 {
+        (self.buffer.len() - 2) as f64
+    }
+
+    /// The input of `delay_samples` (≥ 1) ago, linearly interpolated.
+    #[inline]
+    fn read(&self, delay_samples: f64) -> f64 {
+        let whole = delay_samples.floor();
+        let fraction = delay_samples - whole;
+        let newer = self.buffer[self.write.wrapping_sub(whole as usize) & self.mask];
+        let older = self.buffer[self.write.wrapping_sub(whole as usize + 1) & self.mask];
+        newer + fraction * (older - newer)
+    }
+
+    #[inline]
+    fn push(&mut self, x: f64) {
+        self.buffer[self.write] = x;
+        self.write = (self.write + 1) & self.mask;
+    }
+
+    fn reset(&mut self) {
+        self.buffer.iter_mut().for_each(|x| *x = 0.0);
+        self.write = 0;
+    }
+}
+
+/// STK's bridge-reflection loss, gain 0.95 at low frequency.
+const STRING_FILTER_GAIN: f64 = 0.95;
+
+/// Outer taps σ of the linear-phase loss filter g·[σ, 1 − 2σ, σ] (zero response at Nyquist).
+const STRING_FILTER_SIDE_TAP: f64 = 0.25;
+
+/// Group delay of that filter, samples (constant: it is symmetric).
+const STRING_FILTER_DELAY_SAMPLES: f64 = 1.0;
+
+/// The STK bow-table bowed string.
+#[derive(Clone, Debug)]
+pub struct BowTableString {
+    capacity: BowedCapacity,
+    sample_rate_hz: f64,
+    wave_impedance_n_s_m: f64,
+    full_pressure_force_n: f64,
+    neck: DelayLine,
+    bridge: DelayLine,
+    neck_delay_samples: f64,
+    bridge_delay_samples: f64,
+    filter_history: [f64; 2],
+    body: BodyFilter,
+    body_enabled: bool,
+    pitch_hz: f64,
+    bow_force_n: f64,
+    bow_velocity_m_s: f64,
+    bow_position: f64,
+    slope: f64,
+}
+
+impl BowTableString {
+    /// Allocate for `capacity`; Z₀ from `constants` (only used to express the bridge force in N).
+    /// Starts at 48 kHz (or the capacity's rate if lower), 440 Hz, β = 0.1, bow lifted.
+    pub fn new(capacity: BowedCapacity, constants: StringConstants) -> Self {
+        let max_rate = capacity.max_sample_rate_hz.max(MIN_SAMPLE_RATE_HZ);
+        let lowest_pitch = capacity.lowest_pitch_hz.max(1.0);
+        let capacity = BowedCapacity {
+            max_sample_rate_hz: max_rate,
+            lowest_pitch_hz: lowest_pitch,
+        };
+        let max_delay = max_rate / lowest_pitch;
+        let sample_rate_hz = 48_000.0_f64.min(max_rate);
+        let mut voice = Self {
+            capacity,
+            sample_rate_hz,
+            wave_impedance_n_s_m: constants.wave_impedance_n_s_m(),
+            full_pressure_force_n: DEFAULT_FULL_PRESSURE_FORCE_N,
+            neck: DelayLine::new(max_delay),
+            bridge: DelayLine::new(max_delay),
+            neck_delay_samples: 1.0,
+            bridge_delay_samples: 1.0,
+            filter_history: [0.0; 2],
+            body: BodyFilter::new(&VIOLIN_BODY, sample_rate_hz),
+            body_enabled: true,
+            pitch_hz: 440.0,
+            bow_force_n: 0.0,
+            bow_velocity_m_s: 0.0,
+            bow_position: 0.1,
+            slope: bow_table_slope(0.0),
+        };
+        voice.update_delays();
+        voice
+    }
+
+    /// Bow force that maps to STK pressure 1, N (> 0; other values are ignored).
+    pub fn set_full_pressure_force_n(&mut self, force_n: f64) {
+        if force_n.is_finite() && force_n > 0.0 {
+            self.full_pressure_force_n = force_n;
+            self.set_bow_force_n(self.bow_force_n);
+        }
+    }
+
+    /// Replace the body resonances (at most 8). Allocation-free.
+    pub fn set_body_resonances(&mut self, resonances: &[BodyResonance]) {
+        self.body.set_resonances(resonances);
+    }
+
+    /// The table slope S in use.
+    pub fn slope(&self) -> f64 {
+        self.slope
+    }
+
+    /// Pitch in use after clamping, Hz.
+    pub fn pitch_hz(&self) -> f64 {
+        self.pitch_hz
+    }
+
+    /// Total loop delay through both lines and the loss filter, samples.
+    pub fn loop_delay_samples(&self) -> f64 {
+        self.neck_delay_samples + self.bridge_delay_samples + STRING_FILTER_DELAY_SAMPLES
+    }
+
+    fn update_delays(&mut self) {
+        let period = self.sample_rate_hz / self.pitch_hz;
+        let line_total = period - STRING_FILTER_DELAY_SAMPLES;
+        let max_delay = self.neck.max_delay_samples();
+        self.bridge_delay_samples = (self.bow_position * line_total).clamp(1.0, max_delay);
+        self.neck_delay_samples = ((1.0 - self.bow_position) * line_total).clamp(1.0, max_delay);
+    }
+}
+
+impl BowedVoice for BowTableString {
+    fn prepare(&mut self, sample_rate_hz: f64) -> Result<(), BowedConfigError> {
+        let max_hz = self.capacity.max_sample_rate_hz;
+        if !(MIN_SAMPLE_RATE_HZ..=max_hz).contains(&sample_rate_hz) {
+            return Err(BowedConfigError::SampleRate {
+                requested_hz: sample_rate_hz,
+                min_hz: MIN_SAMPLE_RATE_HZ,
+                max_hz,
+            });
+        }
+        self.sample_rate_hz = sample_rate_hz;
+        self.body.prepare(sample_rate_hz);
+        self.set_pitch_hz(self.pitch_hz);
+        self.reset();
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.neck.reset();
+        self.bridge.reset();
+        self.filter_history = [0.0; 2];
+        self.body.reset();
+    }
+
+    /// Clamped to [lowest pitch of the capacity, sample rate / 4]; non-finite is ignored.
+    fn set_pitch_hz(&mut self, pitch_hz: f64) {
+        if pitch_hz.is_finite() {
+            // min/max, not clamp: a capacity whose lowest pitch exceeds f_s/4 must not panic.
+            self.pitch_hz = pitch_hz
+                .min(0.25 * self.sample_rate_hz)
+                .max(self.capacity.lowest_pitch_hz);
+            self.update_delays();
+        }
+    }
+
+    fn set_bow_force_n(&mut self, bow_force_n: f64) {
+        if bow_force_n.is_finite() {
+            self.bow_force_n = bow_force_n.max(0.0);
+            self.slope = bow_table_slope(self.bow_force_n / self.full_pressure_force_n);
+        }
+    }
+
+    fn set_bow_velocity_m_s(&mut self, bow_velocity_m_s: f64) {
+        if bow_velocity_m_s.is_finite() {
+            self.bow_velocity_m_s = bow_velocity_m_s;
+        }
+    }
+
+    fn set_bow_position(&mut self, beta: f64) {
+        if beta.is_finite() {
+            self.bow_position = beta.clamp(BOW_POSITION_RANGE.0, BOW_POSITION_RANGE.1);
+            self.update_delays();
+        }
+    }
+
+    fn set_body_enabled(&mut self, enabled: bool) {
+        self.body_enabled = enabled;
+    }
+
+    #[inline]
+    fn next_sample(&mut self) -> BowedOutput {
+        let arriving_at_bridge = self.bridge.read(self.bridge_delay_samples);
+        let [previous, before_previous] = self.filter_history;
+        let filtered = STRING_FILTER_GAIN
+            * (STRING_FILTER_SIDE_TAP * (arriving_at_bridge + before_previous)
+                + (1.0 - 2.0 * STRING_FILTER_SIDE_TAP) * previous);
+        self.filter_history = [arriving_at_bridge, previous];
+        let bridge_reflection = -filtered;
+        let nut_reflection = -self.neck.read(self.neck_delay_samples);
+
+        let string_velocity = bridge_reflection + nut_reflection;
+        let differential_velocity = self.bow_velocity_m_s - string_velocity;
+        let bow_wave = if self.bow_force_n > 0.0 {
+            differential_velocity * bow_table_reflection(differential_velocity, self.slope)
+        } else {
+            0.0
+        };
+
+        self.neck.push(bridge_reflection + bow_wave);
+        self.bridge.push(nut_reflection + bow_wave);
+
+        let bridge_force_n = self.wave_impedance_n_s_m * (arriving_at_bridge - bridge_reflection);
+        let radiated = if self.body_enabled {
+            self.body.tick(bridge_force_n)
+        } else {
+            bridge_force_n
+        };
+        let output = BowedOutput {
+            bridge_force_n,
+            bow_point_velocity_m_s: string_velocity + bow_wave,
+            radiated,
+        };
+        if !(output.bridge_force_n.is_finite()
+            && output.bow_point_velocity_m_s.is_finite()
+            && output.radiated.is_finite())
+        {
+            self.reset();
+            return BowedOutput::default();
+        }
+        output
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_values_by_hand() {
+        // Plateau: |Δv| S + 0.75 ≤ 1 gives exactly 1.
+        assert_eq!(bow_table_reflection(0.0, 3.0), 1.0);
+        assert_eq!(bow_table_reflection(0.25, 1.0), 1.0);
+        assert_eq!(bow_table_reflection(-0.05, 5.0), 1.0);
+        // 1.25⁻⁴ = 0.4096; 1.75⁻⁴ = 1/9.37890625; symmetric in Δv.
+        assert!((bow_table_reflection(0.5, 1.0) - 0.4096).abs() < 1e-16);
+        assert!((bow_table_reflection(-0.2, 5.0) - 1.0 / 9.378_906_25).abs() < 1e-16);
+        // Slope: pressure 0 → 5, 1 → 1, 0.5 → 3, clamped outside [0, 1].
+        assert_eq!(bow_table_slope(0.0), 5.0);
+        assert_eq!(bow_table_slope(1.0), 1.0);
+        assert_eq!(bow_table_slope(0.5), 3.0);
+        assert_eq!(bow_table_slope(7.0), 1.0);
+    }
+
+    #[test]
+    fn table_matches_the_seed_formula_everywhere() {
+        for i in -2000..=2000 {
+            let dv = i as f64 * 1e-3;
+            for &slope in &[1.0, 2.5, 4.0, 5.0] {
+                let seed = (dv.abs() * slope + 0.75).powi(-4).min(1.0);
+                let ours = bow_table_reflection(dv, slope);
+                assert!(
+                    (ours - seed).abs() <= 4.0 * f64::EPSILON * seed,
+                    "dv={dv} S={slope}"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,410 @@
+//! [`BowedString`]: the rounded-corner bowed string of McIntyre, Schumacher and Woodhouse
+//! (`shared/notes/bowed-model.md`; Woodhouse 1993, section 3.1).
+//!
+//! Per sample (the note's equations, in this order):
+//!
+//! ```text
+//!     i_b = Σ r_b(k) o_b(n − k)          incoming from the bridge side   (reflection.rs)
+//!     i_n = Σ r_n(k) o_n(n − k)          incoming from the nut/finger side
+//!     v_h = i_b + i_n                    what the string would do without the bow
+//!     (v, f) = line ∩ friction curve     f = 2Z₀ (v − v_h), with hysteresis (bow_point.rs)
+//!     o_b = i_n + f/(2Z₀),  o_n = i_b + f/(2Z₀)
+//! ```
+//!
+//! Outputs: v (the bow-point velocity) and the bridge force. The force of the string on a rigid
+//! bridge is Z₀ (v_incident − v_reflected) (a velocity wave v travelling towards the bridge
+//! carries slope v/c, so force T v/c = Z₀ v; the reflected wave carries the opposite sign). The
+//! wave that arrives at the bridge halfway through the bridge-side round trip is o_b(n − D_b)
+//! (read half a round trip late) and the wave it sends back reaches the bow as i_b(n), so
+//!
+//! ```text
+//!     F_bridge = Z₀ (o_b(n − D_b) − i_b(n))
+//! ```
+//!
+//! which is the bridge force delayed by D_b/2: a constant latency of βP/2 (P the period), which
+//! does not matter for listening and keeps the model causal.
+//!
+//! Physical constants: Z₀ = √(T m) from tension T and linear density m; the wave speed
+//! c = √(T/m); the finger sets the vibrating length L = c/(2 f₀) for the pitch f₀, so the bow
+//! sits βL from the bridge and the round-trip delays are D_b = 2βL/c = β/f₀ and
+//! D_n = 2(1 − β)L/c = (1 − β)/f₀.
+//!
+//! Schelleng's bounds for the current controls (the note; Schelleng 1973):
+//!
+//! ```text
+//!     F_max = 2 Z₀ v_b / (β (μ_s − μ_d))
+//!     F_min = Z₀² v_b / (2 R β² (μ_s − μ_d)),   R = Z₀ (1 + A_b)/(1 − A_b)
+//! ```
+//!
+//! where R is the resistance of a dashpot bridge whose reflection coefficient −(R − Z₀)/(R + Z₀)
+//! equals the bridge pulse's −A_b.
+
+use super::body::{BodyFilter, BodyResonance, VIOLIN_BODY};
+use super::bow_point::{BowPoint, BowPointSolution, ContactState};
+use super::friction::{FrictionLaw, HyperbolicFriction};
+use super::reflection::{ReflectionFunction, ReflectionPulse};
+use super::{BowedCapacity, BowedConfigError, BowedOutput, BowedVoice, MIN_SAMPLE_RATE_HZ};
+
+/// Widest reflection pulse a voice can be given, s.
+pub const MAX_PULSE_WIDTH_S: f64 = 1e-3;
+
+/// Smallest and largest bow position accepted by [`BowedString::set_bow_position`].
+pub const BOW_POSITION_RANGE: (f64, f64) = (0.001, 0.999);
+
+/// The string's physical constants and its two reflection functions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StringConstants {
+    /// Tension T, N (> 0).
+    pub tension_n: f64,
+    /// Linear density m, kg/m (> 0).
+    pub linear_density_kg_m: f64,
+    /// Bridge-side reflection pulse (the bridge is stiff: narrow, nearly lossless).
+    pub bridge_pulse: ReflectionPulse,
+    /// Nut/finger-side reflection pulse (a finger is soft: wider and lossier).
+    pub nut_pulse: ReflectionPulse,
+}
+
+impl StringConstants {
+    /// A violin A string (440 Hz open, 328 mm): T = 50 N, m = 0.6 g/m, so c = 289 m/s and
+    /// Z₀ = √(T m) = 0.173 N s/m. Pulses: bridge 40 µs wide, area 0.98; finger 80 µs,
+    /// area 0.96.
+    pub fn violin_a() -> Self {
+        Self {
+            tension_n: 50.0,
+            linear_density_kg_m: 0.6e-3,
+            bridge_pulse: ReflectionPulse {
+                width_s: 40e-6,
+                area: 0.98,
+            },
+            nut_pulse: ReflectionPulse {
+                width_s: 80e-6,
+                area: 0.96,
+            },
+        }
+    }
+
+    /// A cello D string (146.8 Hz open, 690 mm): T = 150 N, m = 3.65 g/m, c = 203 m/s,
+    /// Z₀ = 0.740 N s/m. Pulses: bridge 80 µs, area 0.98; finger 160 µs, area 0.96.
+    pub fn cello_d() -> Self {
+        Self {
+            tension_n: 150.0,
+            linear_density_kg_m: 3.65e-3,
+            bridge_pulse: ReflectionPulse {
+                width_s: 80e-6,
+                area: 0.98,
+            },
+            nut_pulse: ReflectionPulse {
+                width_s: 160e-6,
+                area: 0.96,
+            },
+        }
+    }
+
+    /// Wave impedance Z₀ = √(T m), N s/m.
+    pub fn wave_impedance_n_s_m(&self) -> f64 {
+        (self.tension_n * self.linear_density_kg_m).sqrt()
+    }
+
+    /// Transverse wave speed c = √(T/m), m/s.
+    pub fn wave_speed_m_s(&self) -> f64 {
+        (self.tension_n / self.linear_density_kg_m).sqrt()
+    }
+}
+
+impl Default for StringConstants {
+    fn default() -> Self {
+        Self::violin_a()
+    }
+}
+
+/// The rounded-corner bowed string, generic over its friction law.
+#[derive(Clone, Debug)]
+pub struct BowedString<F: FrictionLaw = HyperbolicFriction> {
+    capacity: BowedCapacity,
+    constants: StringConstants,
+    friction: F,
+    sample_rate_hz: f64,
+    wave_impedance_n_s_m: f64,
+    bridge: ReflectionFunction,
+    nut: ReflectionFunction,
+    bow: BowPoint,
+    body: BodyFilter,
+    body_enabled: bool,
+    pitch_hz: f64,
+    bow_force_n: f64,
+    bow_velocity_m_s: f64,
+    bow_position: f64,
+    last_solution: BowPointSolution,
+}
+
+impl BowedString<HyperbolicFriction> {
+    /// Allocate for `capacity`, with the hyperbolic friction law of the note. Starts prepared at
+    /// 48 kHz (or the capacity's rate if lower), 440 Hz, β = 0.1, bow lifted, body filter on
+    /// with [`VIOLIN_BODY`].
+    pub fn new(capacity: BowedCapacity, constants: StringConstants) -> Self {
+        Self::with_friction(capacity, constants, HyperbolicFriction::default())
+    }
+}
+
+impl<F: FrictionLaw> BowedString<F> {
+    /// Allocate for `capacity` with any friction law.
+    pub fn with_friction(capacity: BowedCapacity, constants: StringConstants, friction: F) -> Self {
+        let max_rate = capacity.max_sample_rate_hz.max(MIN_SAMPLE_RATE_HZ);
+        let lowest_pitch = capacity.lowest_pitch_hz.max(1.0);
+        let capacity = BowedCapacity {
+            max_sample_rate_hz: max_rate,
+            lowest_pitch_hz: lowest_pitch,
+        };
+        let max_delay = max_rate / lowest_pitch;
+        let max_width = MAX_PULSE_WIDTH_S * max_rate;
+        let sample_rate_hz = 48_000.0_f64.min(max_rate);
+        let mut voice = Self {
+            capacity,
+            constants,
+            friction,
+            sample_rate_hz,
+            wave_impedance_n_s_m: constants.wave_impedance_n_s_m(),
+            bridge: ReflectionFunction::new(max_delay, max_width),
+            nut: ReflectionFunction::new(max_delay, max_width),
+            bow: BowPoint::new(),
+            body: BodyFilter::new(&VIOLIN_BODY, sample_rate_hz),
+            body_enabled: true,
+            pitch_hz: 440.0,
+            bow_force_n: 0.0,
+            bow_velocity_m_s: 0.0,
+            bow_position: 0.1,
+            last_solution: BowPointSolution {
+                velocity_m_s: 0.0,
+                friction_force_n: 0.0,
+                state: ContactState::Sticking,
+                intersections: 1,
+            },
+        };
+        voice.update_reflections();
+        voice
+    }
+
+    /// Replace the string constants (tension, density, pulses). Allocation-free.
+    pub fn set_constants(&mut self, constants: StringConstants) {
+        let valid = constants.tension_n > 0.0
+            && constants.linear_density_kg_m > 0.0
+            && constants.wave_impedance_n_s_m().is_finite();
+        if valid {
+            self.constants = constants;
+            self.wave_impedance_n_s_m = constants.wave_impedance_n_s_m();
+            self.update_reflections();
+        }
+    }
+
+    /// Replace the body resonances (at most 8). Allocation-free.
+    pub fn set_body_resonances(&mut self, resonances: &[BodyResonance]) {
+        self.body.set_resonances(resonances);
+    }
+
+    /// The friction law.
+    pub fn friction(&self) -> &F {
+        &self.friction
+    }
+
+    /// The string constants in use.
+    pub fn constants(&self) -> &StringConstants {
+        &self.constants
+    }
+
+    /// Z₀ = √(T m), N s/m.
+    pub fn wave_impedance_n_s_m(&self) -> f64 {
+        self.wave_impedance_n_s_m
+    }
+
+    /// Sample rate set by `prepare`, Hz.
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+
+    /// Pitch in use after clamping, Hz.
+    pub fn pitch_hz(&self) -> f64 {
+        self.pitch_hz
+    }
+
+    /// Bow position in use after clamping.
+    pub fn bow_position(&self) -> f64 {
+        self.bow_position
+    }
+
+    /// The bridge-side reflection function (for inspection and for setting explicit taps).
+    pub fn bridge_reflection(&self) -> &ReflectionFunction {
+        &self.bridge
+    }
+
+    /// Mutable access to the bridge-side reflection function, e.g. for Woodhouse's [σ, λ, σ].
+    /// The next pitch/position/constants change recomputes the pulse.
+    pub fn bridge_reflection_mut(&mut self) -> &mut ReflectionFunction {
+        &mut self.bridge
+    }
+
+    /// The nut/finger-side reflection function.
+    pub fn nut_reflection(&self) -> &ReflectionFunction {
+        &self.nut
+    }
+
+    /// Mutable access to the nut/finger-side reflection function.
+    pub fn nut_reflection_mut(&mut self) -> &mut ReflectionFunction {
+        &mut self.nut
+    }
+
+    /// The bow-point solution of the last sample (contact state, friction force).
+    pub fn last_bow_point(&self) -> BowPointSolution {
+        self.last_solution
+    }
+
+    /// Schelleng's maximum bow force for the current controls, N.
+    pub fn schelleng_max_force_n(&self) -> f64 {
+        let fall = self.friction.static_coefficient() - self.friction.dynamic_coefficient();
+        2.0 * self.wave_impedance_n_s_m * self.bow_velocity_m_s.abs() / (self.bow_position * fall)
+    }
+
+    /// Schelleng's minimum bow force for the current controls, N, with the bridge taken as a
+    /// dashpot of resistance R = Z₀ (1 + A_b)/(1 − A_b).
+    pub fn schelleng_min_force_n(&self) -> f64 {
+        let fall = self.friction.static_coefficient() - self.friction.dynamic_coefficient();
+        let area = self.constants.bridge_pulse.area;
+        let z0 = self.wave_impedance_n_s_m;
+        let resistance = z0 * (1.0 + area) / (1.0 - area);
+        z0 * z0 * self.bow_velocity_m_s.abs()
+            / (2.0 * resistance * self.bow_position * self.bow_position * fall)
+    }
+
+    fn update_reflections(&mut self) {
+        let period_samples = self.sample_rate_hz / self.pitch_hz;
+        let bridge_delay = self.bow_position * period_samples;
+        let nut_delay = (1.0 - self.bow_position) * period_samples;
+        let bridge = self.constants.bridge_pulse;
+        let nut = self.constants.nut_pulse;
+        self.bridge.set_pulse(
+            bridge_delay,
+            bridge.width_s * self.sample_rate_hz,
+            bridge.area,
+        );
+        self.nut
+            .set_pulse(nut_delay, nut.width_s * self.sample_rate_hz, nut.area);
+    }
+}
+
+impl<F: FrictionLaw> BowedVoice for BowedString<F> {
+    fn prepare(&mut self, sample_rate_hz: f64) -> Result<(), BowedConfigError> {
+        let max_hz = self.capacity.max_sample_rate_hz;
+        if !(MIN_SAMPLE_RATE_HZ..=max_hz).contains(&sample_rate_hz) {
+            return Err(BowedConfigError::SampleRate {
+                requested_hz: sample_rate_hz,
+                min_hz: MIN_SAMPLE_RATE_HZ,
+                max_hz,
+            });
+        }
+        self.sample_rate_hz = sample_rate_hz;
+        self.body.prepare(sample_rate_hz);
+        self.set_pitch_hz(self.pitch_hz);
+        self.reset();
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.bridge.reset();
+        self.nut.reset();
+        self.bow.reset();
+        self.body.reset();
+        self.last_solution = BowPointSolution {
+            velocity_m_s: 0.0,
+            friction_force_n: 0.0,
+            state: ContactState::Sticking,
+            intersections: 1,
+        };
+    }
+
+    /// Clamped to [lowest pitch of the capacity, sample rate / 4]; non-finite is ignored.
+    fn set_pitch_hz(&mut self, pitch_hz: f64) {
+        if pitch_hz.is_finite() {
+            // min/max, not clamp: a capacity whose lowest pitch exceeds f_s/4 must not panic.
+            self.pitch_hz = pitch_hz
+                .min(0.25 * self.sample_rate_hz)
+                .max(self.capacity.lowest_pitch_hz);
+            self.update_reflections();
+        }
+    }
+
+    /// Negative values are taken as 0 (bow lifted); non-finite is ignored.
+    fn set_bow_force_n(&mut self, bow_force_n: f64) {
+        if bow_force_n.is_finite() {
+            self.bow_force_n = bow_force_n.max(0.0);
+        }
+    }
+
+    /// Non-finite is ignored.
+    fn set_bow_velocity_m_s(&mut self, bow_velocity_m_s: f64) {
+        if bow_velocity_m_s.is_finite() {
+            self.bow_velocity_m_s = bow_velocity_m_s;
+        }
+    }
+
+    /// Clamped to [`BOW_POSITION_RANGE`]; non-finite is ignored. Where β/f₀ is shorter than
+    /// one sample the bridge-side delay is held at one sample (the pitch then runs sharp).
+    fn set_bow_position(&mut self, beta: f64) {
+        if beta.is_finite() {
+            self.bow_position = beta.clamp(BOW_POSITION_RANGE.0, BOW_POSITION_RANGE.1);
+            self.update_reflections();
+        }
+    }
+
+    fn set_body_enabled(&mut self, enabled: bool) {
+        self.body_enabled = enabled;
+    }
+
+    #[inline]
+    fn next_sample(&mut self) -> BowedOutput {
+        let z0 = self.wave_impedance_n_s_m;
+        let line_slope = 2.0 * z0;
+
+        let incoming_bridge = self.bridge.incoming();
+        let incoming_nut = self.nut.incoming();
+        let free_velocity = incoming_bridge + incoming_nut;
+
+        let solution = self.bow.solve(
+            &self.friction,
+            line_slope,
+            free_velocity,
+            self.bow_velocity_m_s,
+            self.bow_force_n,
+        );
+        let bow_wave = solution.friction_force_n / line_slope;
+        let outgoing_bridge = incoming_nut + bow_wave;
+        let outgoing_nut = incoming_bridge + bow_wave;
+
+        // Read before pushing: the wave sent towards the bridge one round trip ago.
+        let arriving_at_bridge = self.bridge.outgoing_delayed(self.bridge.delay_samples());
+        self.bridge.push(outgoing_bridge);
+        self.nut.push(outgoing_nut);
+
+        let bridge_force_n = z0 * (arriving_at_bridge - incoming_bridge);
+        let radiated = if self.body_enabled {
+            self.body.tick(bridge_force_n)
+        } else {
+            bridge_force_n
+        };
+
+        let output = BowedOutput {
+            bridge_force_n,
+            bow_point_velocity_m_s: solution.velocity_m_s,
+            radiated,
+        };
+        if !(output.bridge_force_n.is_finite()
+            && output.bow_point_velocity_m_s.is_finite()
+            && output.radiated.is_finite()
+            && outgoing_bridge.is_finite()
+            && outgoing_nut.is_finite())
+        {
+            self.reset();
+            return BowedOutput::default();
+        }
+        self.last_solution = solution;
+        output
+    }
+}
