@@ -15,6 +15,7 @@ use crate::args::Args;
 use javari_core::analysis::{
     band_power, cents, peak_frequency_hz, power_spectrum, spectral_centroid_hz,
 };
+use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
 use javari_core::excitation::Pluck;
 use javari_core::newton::NewtonStats;
 use javari_core::quality::Quality;
@@ -95,6 +96,45 @@ impl Scene for Drone {
 
     fn newton_stats(&self) -> NewtonStats {
         self.tanpura.newton_stats()
+    }
+}
+
+/// One bowed note: A3 on a violin-like string, β = 0.1, 0.1 m/s, a bow force in the middle of
+/// Schelleng's range, body filter on.
+struct BowedNote<V: BowedVoice> {
+    voice: V,
+    stats: NewtonStats,
+}
+
+const BOWED_PITCH_HZ: f64 = 220.0;
+
+impl<V: BowedVoice> BowedNote<V> {
+    fn new(mut voice: V) -> Self {
+        voice
+            .prepare(SAMPLE_RATE)
+            .expect("44.1 kHz is inside every bowed voice's capacity");
+        voice.set_pitch_hz(BOWED_PITCH_HZ);
+        voice.set_bow_position(0.1);
+        voice.set_bow_velocity_m_s(0.1);
+        voice.set_bow_force_n(0.4);
+        voice.set_body_enabled(true);
+        Self {
+            voice,
+            stats: NewtonStats::default(),
+        }
+    }
+}
+
+impl<V: BowedVoice> Scene for BowedNote<V> {
+    fn render_block(&mut self, block: &mut [f32], _first_sample: usize) {
+        for sample in block.iter_mut() {
+            *sample = self.voice.next_sample().radiated as f32;
+        }
+    }
+
+    /// The bowed voices solve the bow point in closed form: no Newton iterations to report.
+    fn newton_stats(&self) -> NewtonStats {
+        self.stats
     }
 }
 
@@ -279,6 +319,31 @@ pub fn run_all(seconds: f64) -> Vec<BenchResult> {
         }
         results.extend(scene_results);
     }
+    let capacity = BowedCapacity::default();
+    let mut rounded = BowedNote::new(BowedString::new(capacity, StringConstants::violin_a()));
+    let mut table = BowedNote::new(BowTableString::new(capacity, StringConstants::violin_a()));
+    eprintln!("bench: bowed-note ...");
+    let reference = measure(
+        &mut rounded,
+        seconds,
+        "bowed",
+        "rounded-corner",
+        "bowed-note",
+        BOWED_PITCH_HZ,
+    );
+    let mut cheap = measure(
+        &mut table,
+        seconds,
+        "bowed",
+        "bow-table",
+        "bowed-note",
+        BOWED_PITCH_HZ,
+    );
+    compare_with_reference(&mut cheap, &reference);
+    // The formant trajectory is the tanpura's measure; a bowed note has none.
+    cheap.formant_error = None;
+    results.push(reference);
+    results.push(cheap);
     results
 }
 
