@@ -597,11 +597,20 @@ impl TanpuraString {
         energy
     }
 
+    /// Forgets what the solver carried over from earlier steps (Newton's initial guess), so
+    /// that a new excitation evolves exactly as it would on a freshly built string.
+    fn forget_motion_history(&mut self) {
+        if let Some(condensation) = &mut self.solver.condensation {
+            condensation.clear_correction();
+        }
+    }
+
     /// The seed's finger pluck: press the finger (k_f > 0) until the string is in static
     /// equilibrium against finger, bridge and thread, then release it (k_f → 0). The string's
     /// previous motion is stopped by the finger. The energy this adds is booked as external
     /// work. Allocation-free.
     pub fn pluck(&mut self, pluck: &Pluck) {
+        self.forget_motion_history();
         let energy_before = self.energy_j();
         let length = self.config.string.length_m;
         let width = pluck.width_m.clamp(
@@ -653,6 +662,7 @@ impl TanpuraString {
     /// The seed's "first mode" initial condition: the rest shape plus `amplitude_m` times the
     /// first mode of the speaking length, released from rest. Allocation-free.
     pub fn excite_first_mode(&mut self, amplitude_m: f64) {
+        self.forget_motion_history();
         let energy_before = self.energy_j();
         let start = self.config.speaking_start_m();
         let length = self.config.string.length_m;

@@ -252,3 +252,42 @@ fn denormal_level_excitation_sleeps_instead_of_computing() {
         assert_eq!(voice.newton_stats().steps, steps);
     }
 }
+
+#[test]
+fn a_sleeping_string_wakes_exactly_on_its_next_pluck() {
+    for quality in Quality::ALL {
+        let settings = VoiceSettings {
+            quality,
+            gamma_per_s: 20.0,
+            ..VoiceSettings::default()
+        };
+        let mut fresh = TanpuraVoice::new(&settings, 44_100.0);
+        let mut slept = TanpuraVoice::new(&settings, 44_100.0);
+        slept.pluck(&Pluck::default());
+        let mut samples = 0;
+        while slept.is_active() {
+            slept.next_sample();
+            samples += 1;
+            assert!(samples < 44_100 * 10, "{quality:?} never fell asleep");
+        }
+        let steps_when_asleep = slept.newton_stats().steps;
+        for _ in 0..500 {
+            assert_eq!(slept.next_sample(), 0.0);
+        }
+        assert_eq!(
+            slept.newton_stats().steps,
+            steps_when_asleep,
+            "asleep means no steps"
+        );
+        fresh.pluck(&Pluck::default());
+        slept.pluck(&Pluck::default());
+        for k in 0..2000 {
+            let (a, b) = (fresh.next_sample(), slept.next_sample());
+            assert_eq!(
+                a.to_bits(),
+                b.to_bits(),
+                "{quality:?} sample {k}: {a} vs {b}"
+            );
+        }
+    }
+}
