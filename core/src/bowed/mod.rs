@@ -10,7 +10,8 @@
 //!   with hysteresis;
 //! - [`body`]: an optional body filter of a few resonances;
 //! - [`bowed_string`]: [`BowedString`], the rounded-corner voice;
-//! - [`bow_table`]: [`BowTableString`], the STK bow-table waveguide (seed 004), the cheap tier.
+//! - [`bow_table`]: [`BowTableString`], the STK bow-table waveguide (seed 004), the cheap tier;
+//! - [`instrument`]: [`BowedInstrument`], MIDI gestures mapped onto one bowed string.
 //!
 //! Both voices implement [`BowedVoice`], so the plugin can switch tiers behind one interface.
 
@@ -19,6 +20,7 @@ pub mod bow_point;
 pub mod bow_table;
 pub mod bowed_string;
 pub mod friction;
+pub mod instrument;
 pub mod reflection;
 
 pub use body::{BodyFilter, BodyResonance, VIOLIN_BODY};
@@ -26,6 +28,7 @@ pub use bow_point::{BowPoint, BowPointSolution, ContactState};
 pub use bow_table::{bow_table_reflection, bow_table_slope, BowTableString};
 pub use bowed_string::{BowedString, StringConstants};
 pub use friction::{ExponentialFriction, FrictionLaw, HyperbolicFriction};
+pub use instrument::{BowTier, BowedEvent, BowedInstrument, BowedPlayerSettings};
 pub use reflection::{ReflectionFunction, ReflectionPulse};
 
 /// Capacity a voice is built for: `new()` allocates for these, `prepare()` must stay within.
