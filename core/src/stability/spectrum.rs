@@ -79,16 +79,22 @@ pub fn spectrum(matrix: &faer::Mat<f64>) -> Result<Vec<Eigenvalue>, StabilityErr
     Ok(eigenvalues)
 }
 
-/// Sorts by decreasing modulus, ties (conjugate pairs, to rounding) by decreasing phase.
+/// Sorts by decreasing modulus; within a run of moduli equal to rounding (conjugate pairs,
+/// the repeated eigenvalues of the space-time formulation) by decreasing phase.
 pub fn sort_by_decreasing_modulus(eigenvalues: &mut [Eigenvalue]) {
-    eigenvalues.sort_by(|a, b| {
-        let modulus_gap = b.modulus - a.modulus;
-        if modulus_gap.abs() <= 1e-12 * a.modulus.max(b.modulus) {
-            b.phase_over_2pi.total_cmp(&a.phase_over_2pi)
-        } else {
-            b.modulus.total_cmp(&a.modulus)
+    eigenvalues.sort_by(|a, b| b.modulus.total_cmp(&a.modulus));
+    let mut run_start = 0;
+    for index in 1..=eigenvalues.len() {
+        let run_ends = index == eigenvalues.len() || {
+            let (previous, current) = (eigenvalues[index - 1].modulus, eigenvalues[index].modulus);
+            previous - current > 1e-12 * previous
+        };
+        if run_ends {
+            eigenvalues[run_start..index]
+                .sort_by(|a, b| b.phase_over_2pi.total_cmp(&a.phase_over_2pi));
+            run_start = index;
         }
-    });
+    }
 }
 
 /// The largest modulus among the eigenvalues of `matrix`.
