@@ -619,3 +619,42 @@ fn playable_range_of_the_transient_model() {
     assert!(exists(34.0, &helmholtz) && !exists(34.6, &helmholtz));
     assert!(!exists(77.2, &helmholtz));
 }
+
+/// Fig. 9: halving the slip time (Fig. 8, eq. 16) never lowers the Helmholtz threshold of Fig. 7
+/// and raises it by "rather more than a factor of two" at most. Checked on p = 1, 2 (all q) and on
+/// β = 0.4, where the full sweep (`cargo xtask stability --sweep fig7|fig8`) finds the maximum.
+#[test]
+fn fig_9_halving_the_slip_time_never_lowers_the_threshold() {
+    let lambda = 0.9995;
+    let ratio = |p: usize, q: usize| {
+        let helmholtz = threshold_zeta(
+            &PeriodicMotion::new(
+                CompactModel::raman(p, q, lambda).unwrap(),
+                ContactPattern::helmholtz_compact(p, q).unwrap(),
+                1.0,
+            )
+            .unwrap(),
+        );
+        let half_slip = threshold_zeta(
+            &PeriodicMotion::new(
+                SpaceTimeModel::new(p, q, lambda).unwrap(),
+                ContactPattern::single_slip(2 * (p + q), p).unwrap(),
+                1.0,
+            )
+            .unwrap(),
+        );
+        half_slip / helmholtz
+    };
+    let mut unchanged = 0;
+    for p in 1..=2 {
+        for q in p..=20 {
+            let value = ratio(p, q);
+            assert!(value > 1.0 - 1e-7, "p = {p}, q = {q}: ratio {value}");
+            if value < 1.0 + 1e-7 {
+                unchanged += 1;
+            }
+        }
+    }
+    assert!(unchanged > 0);
+    assert!((ratio(6, 9) - 2.3051).abs() < 5e-5);
+}
