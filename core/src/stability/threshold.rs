@@ -209,7 +209,9 @@ impl ThresholdSearch {
         // Refine: Illinois regula falsi; bisect whenever the bracket fails to halve in two steps.
         let mut width_two_steps_ago = f64::INFINITY;
         let mut width_one_step_ago = unstable_zeta - stable_zeta;
-        let mut retained_side: Option<bool> = None;
+        // Which end the previous trial replaced (true: the unstable end). When the same end is
+        // replaced twice running, the Illinois rule halves the value kept at the other end.
+        let mut last_replaced_unstable: Option<bool> = None;
         while unstable_zeta - stable_zeta > self.tolerance {
             let width = unstable_zeta - stable_zeta;
             let zeta = if width > 0.5 * width_two_steps_ago {
@@ -230,17 +232,17 @@ impl ThresholdSearch {
             if value > 0.0 {
                 unstable_zeta = zeta;
                 unstable_excess = value;
-                if retained_side == Some(true) {
+                if last_replaced_unstable == Some(true) {
                     stable_excess *= 0.5;
                 }
-                retained_side = Some(true);
+                last_replaced_unstable = Some(true);
             } else {
                 stable_zeta = zeta;
                 stable_excess = value;
-                if retained_side == Some(false) {
+                if last_replaced_unstable == Some(false) {
                     unstable_excess *= 0.5;
                 }
-                retained_side = Some(false);
+                last_replaced_unstable = Some(false);
             }
         }
         let zeta = 0.5 * (stable_zeta + unstable_zeta);
