@@ -126,6 +126,10 @@ fn table_i_critical_zeta_is_0_0122_in_both_formulations() {
 #[test]
 fn equation_13_for_beta_one_over_n() {
     let lambda = 0.9995;
+    // Our α for n = 2 … 8, pinned (docs/stability.md lists them beside eq. 13).
+    let computed = [
+        1.00075, 2.00250, 2.00250, 2.76845, 3.00526, 3.69005, 4.00902,
+    ];
     for n in 2..=8usize {
         let motion = PeriodicMotion::new(
             SpaceTimeModel::new(1, n - 1, lambda).unwrap(),
@@ -142,6 +146,10 @@ fn equation_13_for_beta_one_over_n() {
             n_real / (1.0 - (std::f64::consts::PI * (n_real - 1.0) / n_real).cos())
         };
         let alpha = threshold.alpha(lambda);
+        assert!(
+            (alpha - computed[n - 2]).abs() < 5e-6,
+            "n = {n}: α = {alpha}"
+        );
         assert!(
             (alpha / closed_form - 1.0).abs() < 0.01,
             "n = {n}: α = {alpha}, eq. 13 gives {closed_form}"
@@ -580,7 +588,7 @@ fn transient_at_bow_force_2_leaves_helmholtz_and_settles_on_one_slip() {
     );
 
     let left_helmholtz = run.slips.iter().position(|&slips| slips != 2).unwrap();
-    assert!((3000..10_000).contains(&left_helmholtz), "{left_helmholtz}");
+    assert!((7680..=7690).contains(&left_helmholtz), "{left_helmholtz}");
     assert!(run.slips[11_000..].iter().all(|&slips| slips == 1));
     assert!(
         run.final_period_change < 1e-9,
