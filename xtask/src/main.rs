@@ -4,7 +4,9 @@
 
 mod args;
 mod bench;
+mod plot;
 mod simulate;
+mod stability;
 
 use std::process::ExitCode;
 
@@ -13,7 +15,8 @@ const USAGE: &str = "usage: cargo xtask <command> [options]
 commands:
   simulate    probe one tanpura string: CSV of nut force, bridge force, energy, Newton statistics
               (`cargo xtask simulate --help` lists its options)
-  bench       every quality tier on the same scenes: speed, block times, error against reference";
+  bench       every quality tier on the same scenes: speed, block times, error against reference
+  stability   Woodhouse stability analysis: thresholds, eigenvalues, paper sweeps, preset margin";
 
 fn main() -> ExitCode {
     let raw: Vec<String> = std::env::args().skip(1).collect();
@@ -24,6 +27,7 @@ fn main() -> ExitCode {
     let result: Result<(), Box<dyn std::error::Error>> = match command.as_str() {
         "simulate" => simulate::run(rest),
         "bench" => bench::run(rest),
+        "stability" => stability::run(rest),
         "help" | "--help" | "-h" => {
             println!("{USAGE}");
             Ok(())
