@@ -37,6 +37,7 @@ pub mod spacetime;
 pub mod spectrum;
 pub mod threshold;
 pub mod transient;
+pub mod voice_link;
 
 pub use compact::{CompactModel, ReflectionFunction};
 pub use margin::{stability_margin, BowedSetting, StabilityMargin};
@@ -45,6 +46,7 @@ pub use spacetime::SpaceTimeModel;
 pub use spectrum::{subharmonic_order, Eigenvalue};
 pub use threshold::{PeriodicMotion, Threshold, ThresholdOutcome, ThresholdSearch};
 pub use transient::{RamanTransient, RamanTransientConfig};
+pub use voice_link::{voice_stability_margin, VoiceSetting};
 
 use std::fmt;
 
