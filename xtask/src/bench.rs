@@ -427,6 +427,73 @@ impl Scene for OneOfFour {
     }
 }
 
+/// The issue's targets, each checked against the measured results: met, or missed by how much.
+pub fn targets_markdown(results: &[BenchResult]) -> String {
+    let find = |voice: &str, tier: &str, scene: &str| {
+        results
+            .iter()
+            .find(|r| r.voice == voice && r.tier == tier && r.scene == scene)
+    };
+    let mut text = String::from("\nTargets:\n\n| target | measured | verdict |\n|---|---|---|\n");
+    let mut line = |target: &str, measured: Option<f64>, goal: f64, at_least: bool, unit: &str| {
+        let (shown, verdict) = match measured {
+            None => ("not measured".to_string(), "—".to_string()),
+            Some(value) => {
+                let met = if at_least {
+                    value >= goal
+                } else {
+                    value <= goal
+                };
+                let verdict = if met {
+                    "met".to_string()
+                } else if at_least {
+                    format!("missed: {:.1}× short", goal / value)
+                } else {
+                    format!("missed: {:.1}× over", value / goal)
+                };
+                (format!("{value:.2}{unit}"), verdict)
+            }
+        };
+        let _ = writeln!(text, "| {target} | {shown} | {verdict} |");
+    };
+    line(
+        "reference tier, one string: ≥ 4× real time",
+        find("tanpura", "reference", "one-string").map(|r| r.realtime_factor),
+        4.0,
+        true,
+        "×",
+    );
+    line(
+        "live tier, one string: ≥ 100× real time",
+        find("tanpura", "live", "one-string").map(|r| r.realtime_factor),
+        100.0,
+        true,
+        "×",
+    );
+    line(
+        "live tier: first ten partials within 3 cents of reference",
+        find("tanpura", "live", "one-string").and_then(|r| r.cents_error_max),
+        3.0,
+        false,
+        " cents",
+    );
+    line(
+        "live tier, drone: worst 64-sample block < 10 % of its deadline",
+        find("tanpura", "live", "drone").map(|r| 100.0 * r.block_max),
+        10.0,
+        false,
+        " %",
+    );
+    line(
+        "bowed rounded-corner voice: ≥ 1000× real time",
+        find("bowed", "rounded-corner", "bowed-note").map(|r| r.realtime_factor),
+        1000.0,
+        true,
+        "×",
+    );
+    text
+}
+
 pub fn economy_markdown(rows: &[EconomyRow]) -> String {
     let mut text = String::from(
         "\nSimulating only what the scene needs (live tier):\n\n\
@@ -560,7 +627,8 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn Error>> {
     let machine = machine_name();
     let results = run_all(seconds);
     let economy = run_economy(seconds);
-    let table = to_markdown(&machine, &results) + &economy_markdown(&economy);
+    let table =
+        to_markdown(&machine, &results) + &targets_markdown(&results) + &economy_markdown(&economy);
     print!("{table}");
     std::fs::write(&markdown, &table)
         .map_err(|error| format!("cannot write `{}`: {error}", markdown.display()))?;
