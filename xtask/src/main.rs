@@ -4,6 +4,8 @@
 
 mod args;
 mod bench;
+mod bundle;
+mod render;
 mod simulate;
 
 use std::process::ExitCode;
@@ -11,6 +13,8 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: cargo xtask <command> [options]
 
 commands:
+  render      MIDI file (or the built-in demo) to WAV through the plugin's engine
+  bundle      build target/bundled/<package>.clap and .vst3 (cargo xtask bundle javari --release)
   simulate    probe one tanpura string: CSV of nut force, bridge force, energy, Newton statistics
               (`cargo xtask simulate --help` lists its options)
   bench       every quality tier on the same scenes: speed, block times, error against reference";
@@ -22,6 +26,8 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     };
     let result: Result<(), Box<dyn std::error::Error>> = match command.as_str() {
+        "render" => render::run(rest),
+        "bundle" | "bundle-universal" => bundle::run(&raw),
         "simulate" => simulate::run(rest),
         "bench" => bench::run(rest),
         "help" | "--help" | "-h" => {

@@ -28,6 +28,7 @@ pub mod pitch;
 pub mod preset;
 pub mod render;
 pub mod smoothing;
+pub mod wav;
 
 use crate::excitation::Pluck;
 use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
