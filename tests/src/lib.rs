@@ -185,6 +185,23 @@ pub fn repository_root() -> PathBuf {
         .to_path_buf()
 }
 
+/// The plugin's shared library as `cargo test` builds it (the `javari` cdylib with
+/// `assert_process_allocs`): in `target/<profile>/deps/` beside the test executable, or one
+/// directory up.
+pub fn plugin_library() -> PathBuf {
+    let file = format!(
+        "{}javari{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    );
+    let executable = std::env::current_exe().expect("the test executable's path");
+    let deps = executable.parent().expect("the deps directory");
+    [deps.join(&file), deps.join("..").join(&file)]
+        .into_iter()
+        .find(|path| path.exists())
+        .unwrap_or_else(|| panic!("{file} not found near {}", deps.display()))
+}
+
 /// Magnitude of the Hann-windowed signal's spectrum at `frequency_hz` (one DTFT bin).
 pub fn windowed_magnitude(signal: &[f32], sample_rate_hz: f64, frequency_hz: f64) -> f64 {
     let length = signal.len() as f64;
