@@ -165,7 +165,7 @@ fn clap_state_round_trip_restores_parameters() {
         .expect("the state extension");
     let mut saved = Vec::new();
     state_extension
-        .save(&mut first.plugin_handle(), &mut saved)
+        .save(&first.plugin_handle(), &mut saved)
         .expect("save");
     let text = state_json(&saved);
     assert!(text.contains("\"gain\""), "parameters by stable ID: {text}");
@@ -180,13 +180,13 @@ fn clap_state_round_trip_restores_parameters() {
         .unwrap();
     extension
         .load(
-            &mut second.plugin_handle(),
+            &second.plugin_handle(),
             &mut state_bytes(&edited).as_slice(),
         )
         .expect("load");
     let mut resaved = Vec::new();
     extension
-        .save(&mut second.plugin_handle(), &mut resaved)
+        .save(&second.plugin_handle(), &mut resaved)
         .expect("save again");
     let resaved = state_json(&resaved);
     assert_eq!(parameter_value(&resaved, "gain"), -6.0206);
