@@ -17,7 +17,7 @@
 //! | `plwid` | Pluck width | mm | 2–40 | 10 | fingertip width |
 //! | `plamp` | Pluck amplitude | mm | 0–5 | 2 | finger lift at full velocity |
 //! | `pick` | Pickup | % nut | 0–100 | 100 | 100: nut force, 0: bridge force |
-//! | `qual` | Quality | | Draft, Standard, High | Standard | 2×/4×/8× oversampling and Newton settings |
+//! | `qual` | Quality | | Draft, Live, Studio, Reference | Live | the core's tiers (`core/src/quality.rs`); not part of the factory presets |
 //! | `gain` | Output gain | dB | −60–24 | 0 | after 2 N = full scale |
 //! | `drone` | Drone | on/off | | off | a held note sets Sa and the strings play the cycle |
 //! | `first` | First string | | Pa, Ma, Ni | Pa | first drone string: 3/4, 2/3 or 15/16 of Sa |
@@ -25,9 +25,10 @@
 //! | `dbpm` | Drone tempo | bpm | 20–300 | 60 | tempo without sync |
 
 use javari_core::engine::drone::TEMPO_RANGE_BPM;
-use javari_core::engine::preset::{Preset, Quality, PLUCK_POSITION_RANGE_M};
+use javari_core::engine::preset::{Preset, PLUCK_POSITION_RANGE_M};
 use javari_core::engine::{EngineSettings, OUTPUT_GAIN_RANGE_DB};
 use javari_core::excitation::Pluck;
+use javari_core::quality::Quality;
 use javari_core::tanpura::{FirstString, VoiceSettings};
 use javari_core::tanpura_string::ThreadSettings;
 use nice_plug::prelude::*;
@@ -50,14 +51,17 @@ pub enum PresetChoice {
     Soft,
 }
 
+/// The core's quality tiers (`core/src/quality.rs`), cheapest first.
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum QualityChoice {
     #[id = "draft"]
     Draft,
-    #[id = "standard"]
-    Standard,
-    #[id = "high"]
-    High,
+    #[id = "live"]
+    Live,
+    #[id = "studio"]
+    Studio,
+    #[id = "reference"]
+    Reference,
 }
 
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -204,7 +208,8 @@ impl Default for JavariParams {
             )
             .with_unit(" % nut")
             .with_step_size(0.1),
-            quality: EnumParam::new("Quality", QualityChoice::Standard),
+            // Live by default: a DAW needs real time; the renderer defaults to Reference.
+            quality: EnumParam::new("Quality", QualityChoice::Live),
             output_gain_db: FloatParam::new(
                 "Output gain",
                 0.0,
@@ -237,7 +242,7 @@ pub const BRIDGE_STIFFNESS_LOG10_RANGE: (f32, f32) = (5.0, 11.0);
 
 impl JavariParams {
     /// The engine settings the parameters describe; a factory preset other than `Custom`
-    /// replaces the sound (every parameter but the output gain and the drone switches).
+    /// replaces the sound (every parameter but quality, output gain and the drone controls).
     pub fn engine_settings(&self, factory: &[Preset; 4]) -> EngineSettings {
         let gain_db = f64::from(self.output_gain_db.value());
         let drone_from_knobs = javari_core::engine::drone::DroneSettings {
@@ -257,13 +262,20 @@ impl JavariParams {
             PresetChoice::BrightJawari => Some(&factory[2]),
             PresetChoice::Soft => Some(&factory[3]),
         };
+        let quality = match self.quality.value() {
+            QualityChoice::Draft => Quality::Draft,
+            QualityChoice::Live => Quality::Live,
+            QualityChoice::Studio => Quality::Studio,
+            QualityChoice::Reference => Quality::Reference,
+        };
         if let Some(preset) = preset {
             let mut settings = preset.settings;
+            settings.voice.quality = quality;
             settings.output_gain_db += gain_db;
             settings.drone = drone_from_knobs;
             return settings;
         }
-        let mut voice = VoiceSettings {
+        let voice = VoiceSettings {
             thread_enabled: self.thread_enabled.value(),
             thread_position_m: f64::from(self.thread_position_mm.value()) / MM_PER_M,
             bridge_stiffness_n_m2: 10f64.powf(f64::from(self.bridge_stiffness_log10.value())),
@@ -271,14 +283,9 @@ impl JavariParams {
             gamma_per_s: f64::from(self.gamma_per_s.value()),
             eta_s: f64::from(self.eta_ns.value()) / NS_PER_S,
             nut_pickup_weight: f64::from(self.nut_pickup_percent.value()) / 100.0,
+            quality,
             ..VoiceSettings::default()
         };
-        let quality = match self.quality.value() {
-            QualityChoice::Draft => Quality::Draft,
-            QualityChoice::Standard => Quality::Standard,
-            QualityChoice::High => Quality::High,
-        };
-        quality.apply(&mut voice);
         EngineSettings {
             voice,
             pluck: Pluck {

@@ -7,7 +7,8 @@
 //!   --out FILE.wav       default out/demo.wav, or out/<midi name>.wav
 //!   --sample-rate HZ     8000–192000, default 44100
 //!   --block-size N       1–65536 samples per process call, default 512
-//!   --quality TIER       draft | standard | high, or preset (default: the preset's own)
+//!   --quality TIER       draft | live | studio | reference, or preset (default: the preset's
+//!                        own, else reference)
 //!   --tail-seconds S     0–60 s rendered after the last event, default 3
 //!   --plot FILE.png      spectrogram of the result (needs the plot module)
 //!
@@ -15,10 +16,11 @@
 
 use crate::args::Args;
 use javari_core::engine::midi_file;
-use javari_core::engine::preset::{Preset, Quality};
+use javari_core::engine::preset::{Preset, QUALITY_NAMES};
 use javari_core::engine::render::{render, rendered_length, RenderOptions, Score};
 use javari_core::engine::wav::write_wav;
 use javari_core::engine::EngineSettings;
+use javari_core::quality::Quality;
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -31,11 +33,9 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
     let sample_rate_hz: f64 = args.number("sample-rate", 44_100.0, 8_000.0, 192_000.0)?;
     let block_size: usize = args.number("block-size", 512, 1, 65_536)?;
     // "preset" keeps the preset's own quality.
-    let quality = args.choice(
-        "quality",
-        "preset",
-        &["draft", "standard", "high", "preset"],
-    )?;
+    let mut quality_choices = QUALITY_NAMES.to_vec();
+    quality_choices.push("preset");
+    let quality = args.choice("quality", "preset", &quality_choices)?;
     let quality = Quality::from_name(quality);
     let tail_s: f64 = args.number("tail-seconds", 3.0, 0.0, 60.0)?;
     let plot = args.text("plot").map(PathBuf::from);
@@ -59,7 +59,7 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
         None => EngineSettings::default(),
     };
     if let Some(quality) = quality {
-        quality.apply(&mut settings.voice);
+        settings.voice.quality = quality;
     }
     let options = RenderOptions {
         sample_rate_hz,
@@ -77,7 +77,7 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
                 .to_string()),
         total as f64 / sample_rate_hz,
         sample_rate_hz,
-        Quality::of(&settings.voice).name(),
+        settings.voice.quality.name(),
         out.display()
     );
     let started = Instant::now();

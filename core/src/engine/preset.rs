@@ -15,7 +15,7 @@
 //! | `gamma_per_s` | 1/s | 0–20 | frequency-independent loss γ |
 //! | `eta_s` | s | 0–1e-6 | frequency-dependent loss η |
 //! | `nut_pickup_weight` | 1 | 0–1 | 1: nut force, 0: bridge force |
-//! | `quality` | text | draft, standard, high | oversampling and Newton settings |
+//! | `quality` | text | draft, live, studio, reference | speed against accuracy (`quality.rs`) |
 //! | `pluck_position_m` | m | 0.05–0.6 | pluck point from the tuning bead |
 //! | `pluck_width_m` | m | 0.002–0.040 | fingertip width |
 //! | `pluck_amplitude_m` | m | 0–0.005 | finger lift at full velocity |
@@ -28,6 +28,7 @@
 use super::drone::TEMPO_RANGE_BPM;
 use super::{EngineSettings, OUTPUT_GAIN_RANGE_DB};
 use crate::excitation::Pluck;
+use crate::quality::Quality;
 use crate::tanpura::{FirstString, VoiceSettings};
 use crate::tanpura_string::ThreadSettings;
 use std::fmt;
@@ -37,59 +38,8 @@ use std::path::Path;
 /// nut (string length 0.668 m).
 pub const PLUCK_POSITION_RANGE_M: (f64, f64) = (0.05, 0.6);
 
-/// Rendering quality: how finely the string is simulated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Quality {
-    /// 2× oversampling, Newton tolerance 1e-11 m, at most 10 iterations.
-    Draft,
-    /// The seed's settings: 4× oversampling (176.4 kHz at 44.1 kHz), tolerance 1e-13 m, 20
-    /// iterations.
-    Standard,
-    /// 8× oversampling, tolerance 1e-14 m, 40 iterations.
-    High,
-}
-
-impl Quality {
-    pub const NAMES: [&'static str; 3] = ["draft", "standard", "high"];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Quality::Draft => "draft",
-            Quality::Standard => "standard",
-            Quality::High => "high",
-        }
-    }
-
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "draft" => Some(Quality::Draft),
-            "standard" => Some(Quality::Standard),
-            "high" => Some(Quality::High),
-            _ => None,
-        }
-    }
-
-    /// Writes this tier's oversampling and Newton settings into `settings`.
-    pub fn apply(self, settings: &mut VoiceSettings) {
-        let (oversample, tolerance, iterations) = match self {
-            Quality::Draft => (2, 1e-11, 10),
-            Quality::Standard => (4, 1e-13, 20),
-            Quality::High => (8, 1e-14, 40),
-        };
-        settings.oversample = oversample;
-        settings.newton_tolerance = tolerance;
-        settings.newton_max_iterations = iterations;
-    }
-
-    /// The tier whose oversampling these settings use (the nearest one).
-    pub fn of(settings: &VoiceSettings) -> Self {
-        match settings.oversample {
-            0..=2 => Quality::Draft,
-            3..=5 => Quality::Standard,
-            _ => Quality::High,
-        }
-    }
-}
+/// Names of the quality tiers, as written in presets ([`Quality::name`]).
+pub const QUALITY_NAMES: [&str; 4] = ["draft", "live", "studio", "reference"];
 
 /// Names of the first drone string's choices, as written in presets.
 pub const FIRST_STRING_NAMES: [&str; 3] = ["pa", "ma", "ni"];
@@ -200,10 +150,9 @@ impl Preset {
                     settings.voice.nut_pickup_weight = value.number((0.0, 1.0))?
                 }
                 "quality" => {
-                    let name = value.choice(&Quality::NAMES)?;
-                    Quality::from_name(name)
-                        .expect("choice() only returns listed names")
-                        .apply(&mut settings.voice);
+                    let name = value.choice(&QUALITY_NAMES)?;
+                    settings.voice.quality =
+                        Quality::from_name(name).expect("choice() only returns listed names");
                 }
                 "pluck_position_m" => {
                     settings.pluck.position_m = value.number(PLUCK_POSITION_RANGE_M)?
@@ -266,7 +215,7 @@ impl Preset {
             v.gamma_per_s,
             v.eta_s,
             v.nut_pickup_weight,
-            Quality::of(v).name(),
+            v.quality.name(),
             s.pluck.position_m,
             s.pluck.width_m,
             s.pluck.amplitude_m,
@@ -373,7 +322,7 @@ mod tests {
         preset.settings.pluck.width_m = 0.02;
         preset.settings.drone.enabled = true;
         preset.settings.drone.first_string = FirstString::Ni;
-        Quality::High.apply(&mut preset.settings.voice);
+        preset.settings.voice.quality = Quality::Studio;
         let parsed = Preset::parse(&preset.to_text(), "mem").unwrap();
         assert_eq!(parsed, preset);
     }
@@ -394,7 +343,10 @@ mod tests {
     fn wrong_kinds_and_unknown_keys_are_errors() {
         let cases = [
             ("thread_enabled = yes", "true or false"),
-            ("quality = \"ultra\"", "\"draft\", \"standard\", \"high\""),
+            (
+                "quality = \"ultra\"",
+                "\"draft\", \"live\", \"studio\", \"reference\"",
+            ),
             ("gamma_per_s = fast", "a number from 0 to 20"),
             ("bridge_stifness = 1e8", "a known key"),
             ("just words", "`key = value`"),
@@ -405,6 +357,12 @@ mod tests {
             let message = Preset::parse(text, "p.toml").unwrap_err().to_string();
             assert!(message.contains(expected), "{text}: {message}");
         }
+    }
+
+    #[test]
+    fn quality_names_are_the_tiers_names() {
+        let names: Vec<&str> = Quality::ALL.iter().map(|quality| quality.name()).collect();
+        assert_eq!(names, QUALITY_NAMES);
     }
 
     #[test]
