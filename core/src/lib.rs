@@ -18,6 +18,7 @@ pub mod barrier_grid;
 pub mod condensed;
 pub mod contact;
 pub mod decimator;
+pub mod engine;
 pub mod excitation;
 pub mod newton;
 pub mod quality;

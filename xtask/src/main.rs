@@ -4,7 +4,9 @@
 
 mod args;
 mod bench;
+mod bundle;
 mod plot;
+mod render;
 mod simulate;
 mod stability;
 
@@ -13,6 +15,8 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: cargo xtask <command> [options]
 
 commands:
+  render      MIDI file (or the built-in demo) to WAV through the plugin's engine
+  bundle      build target/bundled/<package>.clap and .vst3 (cargo xtask bundle javari --release)
   simulate    probe one tanpura string: CSV of nut force, bridge force, energy, Newton statistics
               (`cargo xtask simulate --help` lists its options)
   bench       every quality tier on the same scenes: speed, block times, error against reference
@@ -25,6 +29,8 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     };
     let result: Result<(), Box<dyn std::error::Error>> = match command.as_str() {
+        "render" => render::run(rest),
+        "bundle" | "bundle-universal" => bundle::run(&raw),
         "simulate" => simulate::run(rest),
         "bench" => bench::run(rest),
         "stability" => stability::run(rest),

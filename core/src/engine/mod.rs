@@ -1,0 +1,473 @@
+//! The playing engine: MIDI-like events in, audio out, shared by the plugin and the offline
+//! renderer so that both make exactly the same sound.
+//!
+//! What it does, and where:
+//! - a pool of [`TanpuraVoice`] strings (polyphonic). A string rings on after note-off, as a real
+//!   string does; a voice is taken from another string only by a new pluck: a string already
+//!   tuned to the note is plucked again, else a silent voice is used, else the quietest (then the
+//!   oldest) ringing one is stolen ([`Engine::choose_voice`]);
+//! - note to pitch: 12-TET, A4 = 440 Hz ([`pitch`]);
+//! - drone mode ([`drone`]): a held note sets Sa and the four strings are plucked in the classic
+//!   cycle at the host's tempo;
+//! - smoothing of continuous settings in SI units ([`smoothing`]): the string settings move at
+//!   a control rate of one update every [`CONTROL_INTERVAL`] samples (a string's settings change
+//!   rebuilds its step matrix, so it is not done per sample), reaching the target in
+//!   [`SMOOTHING_TIME_S`]; the output gain ramps per sample;
+//! - sample-accurate events: [`Engine::process`] splits the block at every event, control tick
+//!   and drone pluck. All of these sit at absolute sample times, so the output does not depend on
+//!   the block size;
+//! - the output level: see [`NEWTONS_AT_FULL_SCALE`].
+//!
+//! Lifecycle (design.md): [`Engine::new`] allocates every voice; [`Engine::process`],
+//! [`Engine::set_settings`], [`Engine::set_host_tempo`] and [`Engine::reset`] never allocate,
+//! lock or panic.
+
+pub mod drone;
+pub mod midi_file;
+pub mod pitch;
+pub mod preset;
+pub mod render;
+pub mod smoothing;
+pub mod wav;
+
+use crate::excitation::Pluck;
+use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
+use drone::{string_ratios, DroneSequencer, DroneSettings};
+use smoothing::Ramp;
+
+/// The pickup force, in newtons, that maps to digital full scale (±1.0) at 0 dB output gain,
+/// for a string at the reference pitch ([`reference_fundamental_hz`]).
+///
+/// Measured (`default_pluck_peaks_near_minus_12_dbfs`): the default pluck (2 mm at 0.35 m, 10 mm
+/// finger) on the reference string peaks at about 0.49 N at the nut, so 2 N puts it near
+/// −12 dBFS, which leaves headroom for several strings ringing together.
+pub const NEWTONS_AT_FULL_SCALE: f64 = 2.0;
+/// Samples between two updates of the strings' smoothed settings.
+pub const CONTROL_INTERVAL: u64 = 32;
+/// Time a continuous setting takes to reach a new value, s.
+pub const SMOOTHING_TIME_S: f64 = 0.02;
+/// Output gain range, dB.
+pub const OUTPUT_GAIN_RANGE_DB: (f64, f64) = (-60.0, 24.0);
+/// Time constant of each voice's level follower (used to pick the quietest voice to steal), s.
+const LEVEL_RELEASE_S: f64 = 0.05;
+
+/// Everything the engine plays with, in SI units (normalised mappings live in the plugin).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EngineSettings {
+    /// Settings shared by every string; `fundamental_hz` is ignored (each string has its note's
+    /// pitch).
+    pub voice: VoiceSettings,
+    /// The pluck used for every note, at full velocity (amplitude scales with velocity).
+    pub pluck: Pluck,
+    /// Output gain, dB (−60 to +24), applied after [`NEWTONS_AT_FULL_SCALE`].
+    pub output_gain_db: f64,
+    pub drone: DroneSettings,
+}
+
+impl Default for EngineSettings {
+    fn default() -> Self {
+        Self {
+            voice: VoiceSettings::default(),
+            pluck: Pluck::default(),
+            output_gain_db: 0.0,
+            drone: DroneSettings::default(),
+        }
+    }
+}
+
+/// A musical event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EngineEvent {
+    /// `velocity` in (0, 1]; a note-on with velocity 0 is a note-off, as in MIDI.
+    NoteOn { note: u8, velocity: f32 },
+    /// Releases a held note (drone mode); a plucked string rings on regardless.
+    NoteOff { note: u8 },
+    /// Releases every held note; strings ring on.
+    AllNotesOff,
+    /// Silences every string at once.
+    AllSoundOff,
+}
+
+/// An event at a sample offset within the block passed to [`Engine::process`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimedEvent {
+    pub offset: usize,
+    pub event: EngineEvent,
+}
+
+/// What a voice currently is: which string of the instrument it plays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum StringKey {
+    Note(u8),
+    Drone(usize),
+}
+
+#[derive(Debug, Clone)]
+struct Slot {
+    voice: TanpuraVoice,
+    key: Option<StringKey>,
+    fundamental_hz: f64,
+    /// Output scaling that keeps the level independent of pitch (see [`pitch_level_factor`]).
+    level_factor: f64,
+    /// Absolute sample of the last pluck.
+    plucked_at: u64,
+    /// Peak-following level of the scaled output, for stealing.
+    level: f32,
+}
+
+/// The tension, and with it the force at the nut and bridge for a given displacement, grows
+/// with the square of the pitch. So that a pluck sounds equally loud on any note, each string's
+/// force is multiplied by `(f_ref / f)²`.
+pub fn pitch_level_factor(fundamental_hz: f64) -> f64 {
+    let ratio = reference_fundamental_hz() / fundamental_hz;
+    ratio * ratio
+}
+
+/// The polyphonic tanpura engine.
+#[derive(Debug, Clone)]
+pub struct Engine {
+    sample_rate_hz: f64,
+    slots: Vec<Slot>,
+    target: EngineSettings,
+    /// The smoothed shared string settings (fundamental ignored).
+    current_voice: VoiceSettings,
+    bridge_stiffness_log: Ramp,
+    thread_position: Ramp,
+    gamma: Ramp,
+    eta: Ramp,
+    pickup_weight: Ramp,
+    output_gain: Ramp,
+    drone: DroneSequencer,
+    host_tempo_bpm: Option<f64>,
+    /// Absolute sample index of the next sample to be produced.
+    clock: u64,
+    next_control_tick: u64,
+    level_release: f32,
+}
+
+/// `ln(1 + k_b)`: stiffness ramps in a logarithmic domain (its range spans twelve decades) that
+/// still contains 0.
+fn stiffness_to_log(stiffness_n_m2: f64) -> f64 {
+    stiffness_n_m2.ln_1p()
+}
+
+fn log_to_stiffness(log_value: f64) -> f64 {
+    log_value.exp_m1().max(0.0)
+}
+
+fn db_to_amplitude(db: f64) -> f64 {
+    10f64.powf(db / 20.0)
+}
+
+impl Engine {
+    /// An engine with `voice_count` strings (at least 1) at `sample_rate_hz`. Allocates.
+    pub fn new(settings: &EngineSettings, sample_rate_hz: f64, voice_count: usize) -> Self {
+        let voice = settings.voice.clamped();
+        let slots = (0..voice_count.max(1))
+            .map(|_| Slot {
+                voice: TanpuraVoice::new(&voice, sample_rate_hz),
+                key: None,
+                fundamental_hz: voice.fundamental_hz,
+                level_factor: 1.0,
+                plucked_at: 0,
+                level: 0.0,
+            })
+            .collect();
+        let control_steps =
+            (SMOOTHING_TIME_S * sample_rate_hz / CONTROL_INTERVAL as f64).ceil() as u32;
+        let gain_steps = (SMOOTHING_TIME_S * sample_rate_hz).ceil() as u32;
+        let gain = db_to_amplitude(Self::clamp_gain_db(settings.output_gain_db));
+        let mut engine = Self {
+            sample_rate_hz,
+            slots,
+            target: *settings,
+            current_voice: voice,
+            bridge_stiffness_log: Ramp::new(
+                stiffness_to_log(voice.bridge_stiffness_n_m2),
+                control_steps,
+            ),
+            thread_position: Ramp::new(voice.thread_position_m, control_steps),
+            gamma: Ramp::new(voice.gamma_per_s, control_steps),
+            eta: Ramp::new(voice.eta_s, control_steps),
+            pickup_weight: Ramp::new(voice.nut_pickup_weight, control_steps),
+            output_gain: Ramp::new(gain, gain_steps),
+            drone: DroneSequencer::default(),
+            host_tempo_bpm: None,
+            clock: 0,
+            next_control_tick: 0,
+            level_release: (-1.0 / (LEVEL_RELEASE_S * sample_rate_hz)).exp() as f32,
+        };
+        engine.target.voice = voice;
+        engine
+    }
+
+    fn clamp_gain_db(db: f64) -> f64 {
+        if db.is_nan() {
+            0.0
+        } else {
+            db.clamp(OUTPUT_GAIN_RANGE_DB.0, OUTPUT_GAIN_RANGE_DB.1)
+        }
+    }
+
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+
+    pub fn voice_count(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// Number of strings currently computing.
+    pub fn active_voices(&self) -> usize {
+        self.slots
+            .iter()
+            .filter(|slot| slot.voice.is_active())
+            .count()
+    }
+
+    /// New targets. Continuous settings (k_b, thread position, γ, η, pickup mix, gain) glide
+    /// there over [`SMOOTHING_TIME_S`]; switches and quality apply at the next control tick; the
+    /// pluck applies from the next pluck. Allocation-free; out-of-range values are clamped.
+    pub fn set_settings(&mut self, settings: &EngineSettings) {
+        let voice = settings.voice.clamped();
+        self.target = *settings;
+        self.target.voice = voice;
+        self.bridge_stiffness_log
+            .set_target(stiffness_to_log(voice.bridge_stiffness_n_m2));
+        self.thread_position.set_target(voice.thread_position_m);
+        self.gamma.set_target(voice.gamma_per_s);
+        self.eta.set_target(voice.eta_s);
+        self.pickup_weight.set_target(voice.nut_pickup_weight);
+        self.output_gain
+            .set_target(db_to_amplitude(Self::clamp_gain_db(
+                settings.output_gain_db,
+            )));
+    }
+
+    pub fn settings(&self) -> &EngineSettings {
+        &self.target
+    }
+
+    /// The host's tempo for the drone, beats per minute (None when the host reports none).
+    pub fn set_host_tempo(&mut self, tempo_bpm: Option<f64>) {
+        self.host_tempo_bpm = tempo_bpm.filter(|tempo| tempo.is_finite() && *tempo > 0.0);
+    }
+
+    /// Silences every string, releases every note and jumps the smoothed settings to their
+    /// targets. The clock restarts at 0, so a reset engine renders exactly as a new one.
+    pub fn reset(&mut self) {
+        let voice = self.target.voice;
+        self.bridge_stiffness_log
+            .jump_to(stiffness_to_log(voice.bridge_stiffness_n_m2));
+        self.thread_position.jump_to(voice.thread_position_m);
+        self.gamma.jump_to(voice.gamma_per_s);
+        self.eta.jump_to(voice.eta_s);
+        self.pickup_weight.jump_to(voice.nut_pickup_weight);
+        self.output_gain
+            .jump_to(db_to_amplitude(Self::clamp_gain_db(
+                self.target.output_gain_db,
+            )));
+        self.current_voice = voice;
+        for slot in &mut self.slots {
+            slot.voice.reset();
+            slot.key = None;
+            slot.level = 0.0;
+            slot.plucked_at = 0;
+        }
+        self.drone.reset();
+        self.clock = 0;
+        self.next_control_tick = 0;
+    }
+
+    /// Renders `output.len()` samples (overwriting `output`) while applying `events` at their
+    /// offsets. Events must be sorted by offset; an offset past the block is applied at its last
+    /// sample. Allocation-free, never panics.
+    pub fn process(&mut self, events: &[TimedEvent], output: &mut [f32]) {
+        output.fill(0.0);
+        let length = output.len();
+        let mut position = 0;
+        let mut next_event = 0;
+        while position < length {
+            if self.clock >= self.next_control_tick {
+                self.control_tick();
+                self.next_control_tick = self.clock + CONTROL_INTERVAL;
+            }
+            while let Some(timed) = events.get(next_event) {
+                if timed.offset.min(length - 1) > position {
+                    break;
+                }
+                self.handle_event(timed.event);
+                next_event += 1;
+            }
+            self.play_due_drone_pluck();
+
+            let mut end = length;
+            if let Some(timed) = events.get(next_event) {
+                end = end.min(timed.offset.min(length - 1));
+            }
+            end = end.min(position + (self.next_control_tick - self.clock) as usize);
+            if let Some(pluck_sample) = self.drone.next_pluck_sample() {
+                let until = pluck_sample.saturating_sub(self.clock).max(1);
+                end = end.min(position + until.min(length as u64) as usize);
+            }
+            let end = end.max(position + 1);
+            self.render_segment(&mut output[position..end]);
+            self.clock += (end - position) as u64;
+            position = end;
+        }
+    }
+
+    fn render_segment(&mut self, output: &mut [f32]) {
+        let release = self.level_release;
+        for slot in &mut self.slots {
+            if !slot.voice.is_active() {
+                slot.level = 0.0;
+                continue;
+            }
+            let scale = (slot.level_factor / NEWTONS_AT_FULL_SCALE) as f32;
+            let mut level = slot.level;
+            for sample in output.iter_mut() {
+                let value = slot.voice.next_sample() * scale;
+                if !value.is_finite() {
+                    // Fail soft: a voice that blew up is silenced, never passed on.
+                    slot.voice.reset();
+                    level = 0.0;
+                    break;
+                }
+                *sample += value;
+                level = value.abs().max(level * release);
+            }
+            slot.level = level;
+        }
+        for sample in output.iter_mut() {
+            *sample *= self.output_gain.step() as f32;
+        }
+    }
+
+    /// Moves the smoothed settings one control step and passes them to the ringing strings.
+    fn control_tick(&mut self) {
+        let target = self.target.voice;
+        let mut settings = target;
+        settings.bridge_stiffness_n_m2 = log_to_stiffness(self.bridge_stiffness_log.step());
+        settings.thread_position_m = self.thread_position.step();
+        settings.gamma_per_s = self.gamma.step();
+        settings.eta_s = self.eta.step();
+        settings.nut_pickup_weight = self.pickup_weight.step();
+        settings.fundamental_hz = self.current_voice.fundamental_hz;
+        if settings == self.current_voice {
+            return;
+        }
+        self.current_voice = settings;
+        for slot in &mut self.slots {
+            let mut string_settings = settings;
+            string_settings.fundamental_hz = slot.fundamental_hz;
+            slot.voice.set_settings(&string_settings);
+        }
+    }
+
+    fn handle_event(&mut self, event: EngineEvent) {
+        match event {
+            EngineEvent::NoteOn { note, velocity } if velocity > 0.0 => {
+                if self.target.drone.enabled {
+                    self.drone.note_on(note, self.clock);
+                } else if let Some(hz) = pitch::playable_note_hz(note) {
+                    self.pluck_string(StringKey::Note(note), hz, velocity);
+                }
+            }
+            EngineEvent::NoteOn { note, .. } | EngineEvent::NoteOff { note } => {
+                self.drone.note_off(note)
+            }
+            EngineEvent::AllNotesOff => self.drone.all_notes_off(),
+            EngineEvent::AllSoundOff => {
+                self.drone.all_notes_off();
+                for slot in &mut self.slots {
+                    slot.voice.reset();
+                    slot.key = None;
+                    slot.level = 0.0;
+                }
+            }
+        }
+    }
+
+    fn play_due_drone_pluck(&mut self) {
+        if !self.target.drone.enabled {
+            self.drone.all_notes_off();
+            return;
+        }
+        let drone = self.target.drone;
+        let tempo = match (drone.tempo_sync, self.host_tempo_bpm) {
+            (true, Some(host)) => host,
+            _ => drone.free_tempo_bpm,
+        };
+        let Some(string) = self
+            .drone
+            .take_due_pluck(self.clock, tempo, self.sample_rate_hz)
+        else {
+            return;
+        };
+        let Some(sa_note) = self.drone.sa_note() else {
+            return;
+        };
+        let hz = pitch::note_to_hz(sa_note) * string_ratios(drone.first_string)[string];
+        let (low, high) = VoiceSettings::FUNDAMENTAL_RANGE_HZ;
+        if (low..=high).contains(&hz) {
+            self.pluck_string(StringKey::Drone(string), hz, 1.0);
+        }
+    }
+
+    /// The voice a new pluck of `key` at `fundamental_hz` goes to: the same string if it is
+    /// still tuned there (a real string is simply plucked again), else a silent voice, else the
+    /// quietest ringing one, the oldest among equally quiet ones.
+    fn choose_voice(&self, key: StringKey, fundamental_hz: f64) -> usize {
+        if let Some(index) = self
+            .slots
+            .iter()
+            .position(|slot| slot.key == Some(key) && slot.fundamental_hz == fundamental_hz)
+        {
+            return index;
+        }
+        if let Some(index) = self
+            .slots
+            .iter()
+            .enumerate()
+            .filter(|(_, slot)| !slot.voice.is_active())
+            .min_by_key(|(_, slot)| slot.plucked_at)
+            .map(|(index, _)| index)
+        {
+            return index;
+        }
+        self.slots
+            .iter()
+            .enumerate()
+            .min_by(|(_, a), (_, b)| {
+                a.level
+                    .total_cmp(&b.level)
+                    .then(a.plucked_at.cmp(&b.plucked_at))
+            })
+            .map_or(0, |(index, _)| index)
+    }
+
+    fn pluck_string(&mut self, key: StringKey, fundamental_hz: f64, velocity: f32) {
+        let index = self.choose_voice(key, fundamental_hz);
+        let slot = &mut self.slots[index];
+        if slot.key != Some(key) || slot.fundamental_hz != fundamental_hz {
+            let mut string_settings = self.current_voice;
+            string_settings.fundamental_hz = fundamental_hz;
+            // A stolen string is stopped first: its old vibration belongs to another tuning.
+            slot.voice.reset();
+            slot.voice.set_settings(&string_settings);
+            slot.key = Some(key);
+            slot.fundamental_hz = fundamental_hz;
+            slot.level_factor = pitch_level_factor(fundamental_hz);
+        }
+        let mut pluck = self.target.pluck;
+        pluck.amplitude_m *= f64::from(velocity.clamp(0.0, 1.0));
+        slot.voice.pluck(&pluck);
+        slot.plucked_at = self.clock;
+        // A fresh pluck counts as loud until the follower has measured it.
+        slot.level = 1.0;
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,190 @@
+//! Offline rendering: a [`Score`] (events at times in seconds) through the [`Engine`] in blocks,
+//! exactly as a host would drive the plugin. `cargo xtask render` and the tests/ crate both call
+//! [`render`], so what they check is what users hear.
+
+use super::{Engine, EngineEvent, EngineSettings, TimedEvent};
+
+/// Voices the plugin and the renderer allocate: the four drone strings plus four more for
+/// melody notes or overlapping cycles.
+pub const DEFAULT_VOICE_COUNT: usize = 8;
+/// Most events the renderer hands to one `process` call (a block is split when it has more).
+const MAX_EVENTS_PER_CALL: usize = 256;
+
+/// What happens at a score time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ScoreAction {
+    Engine(EngineEvent),
+    /// The host's tempo from here on, beats per minute.
+    Tempo(f64),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScoreEvent {
+    pub time_s: f64,
+    pub action: ScoreAction,
+}
+
+/// Events sorted by time, and the time of the last one.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Score {
+    pub events: Vec<ScoreEvent>,
+    pub end_s: f64,
+}
+
+impl Score {
+    /// The built-in demo: two cycles of a tanpura's four strings played as notes (G2 for Pa,
+    /// C3, C3, C2 for low Sa; one beat at 60 bpm, a rest of two after the low Sa), then a C3–E3–G3
+    /// arpeggio, so that it sounds the same with any preset.
+    pub fn demo() -> Self {
+        let mut score = Score::default();
+        let cycle = [(43u8, 0.0), (48, 1.0), (48, 2.0), (36, 3.0)];
+        for start in [0.0, 5.0] {
+            for (note, offset) in cycle {
+                score.note(start + offset, 0.8, note, 0.9);
+            }
+        }
+        for (index, note) in [48u8, 52, 55].into_iter().enumerate() {
+            score.note(10.0 + 0.25 * index as f64, 1.0, note, 0.7);
+        }
+        score
+    }
+
+    /// Appends a note-on at `time_s` and its note-off `duration_s` later, keeping the order.
+    pub fn note(&mut self, time_s: f64, duration_s: f64, note: u8, velocity: f32) {
+        self.push(
+            time_s,
+            ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }),
+        );
+        self.push(
+            time_s + duration_s,
+            ScoreAction::Engine(EngineEvent::NoteOff { note }),
+        );
+    }
+
+    /// Inserts an event after every event at the same or an earlier time.
+    pub fn push(&mut self, time_s: f64, action: ScoreAction) {
+        let index = self.events.partition_point(|event| event.time_s <= time_s);
+        self.events.insert(index, ScoreEvent { time_s, action });
+        self.end_s = self.end_s.max(time_s);
+    }
+}
+
+/// How to render.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderOptions {
+    pub sample_rate_hz: f64,
+    /// Samples per `process` call, as a host's buffer size.
+    pub block_size: usize,
+    /// Time rendered after the score's last event, s.
+    pub tail_s: f64,
+    pub voice_count: usize,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            sample_rate_hz: 44_100.0,
+            block_size: 512,
+            tail_s: 3.0,
+            voice_count: DEFAULT_VOICE_COUNT,
+        }
+    }
+}
+
+/// The sample index of a score time (rounded to the nearest sample).
+pub fn time_to_sample(time_s: f64, sample_rate_hz: f64) -> usize {
+    (time_s.max(0.0) * sample_rate_hz).round() as usize
+}
+
+/// Number of samples [`render`] produces.
+pub fn rendered_length(score: &Score, options: &RenderOptions) -> usize {
+    time_to_sample(
+        score.end_s + options.tail_s.max(0.0),
+        options.sample_rate_hz,
+    ) + 1
+}
+
+/// Renders `score` with `settings` to a mono signal at full scale ±1. `progress(done, total)`
+/// is called after every block.
+pub fn render(
+    settings: &EngineSettings,
+    score: &Score,
+    options: &RenderOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Vec<f32> {
+    let mut engine = Engine::new(settings, options.sample_rate_hz, options.voice_count);
+    let total = rendered_length(score, options);
+    let mut output = vec![0.0f32; total];
+    let block_size = options.block_size.max(1);
+    let mut block_events: Vec<TimedEvent> = Vec::with_capacity(MAX_EVENTS_PER_CALL);
+    let mut next_event = 0;
+    let mut start = 0;
+    while start < total {
+        let block_end = (start + block_size).min(total);
+        // A block is cut short at a tempo change (the host reports tempo per block) or when it
+        // holds more events than one call takes.
+        let mut end = block_end;
+        let mut engine_events = 0;
+        for event in &score.events[next_event..] {
+            let at = time_to_sample(event.time_s, options.sample_rate_hz);
+            if at >= end {
+                break;
+            }
+            let is_tempo = matches!(event.action, ScoreAction::Tempo(_));
+            if at > start && (is_tempo || engine_events == MAX_EVENTS_PER_CALL) {
+                end = at;
+                break;
+            }
+            engine_events += usize::from(!is_tempo);
+        }
+        block_events.clear();
+        while let Some(event) = score.events.get(next_event) {
+            let at = time_to_sample(event.time_s, options.sample_rate_hz);
+            if at >= end || block_events.len() == MAX_EVENTS_PER_CALL {
+                break;
+            }
+            match event.action {
+                ScoreAction::Tempo(tempo) => engine.set_host_tempo(Some(tempo)),
+                ScoreAction::Engine(engine_event) => block_events.push(TimedEvent {
+                    offset: at.saturating_sub(start),
+                    event: engine_event,
+                }),
+            }
+            next_event += 1;
+        }
+        engine.process(&block_events, &mut output[start..end]);
+        start = end;
+        progress(start, total);
+    }
+    output
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn score_keeps_events_sorted_and_stable() {
+        let mut score = Score::default();
+        score.note(1.0, 1.0, 60, 1.0);
+        score.note(0.5, 0.5, 62, 1.0);
+        let times: Vec<f64> = score.events.iter().map(|event| event.time_s).collect();
+        assert_eq!(times, vec![0.5, 1.0, 1.0, 2.0]);
+        // At 1.0 s the earlier-inserted note-on stays before the later note-off.
+        assert_eq!(
+            score.events[1].action,
+            ScoreAction::Engine(EngineEvent::NoteOn {
+                note: 60,
+                velocity: 1.0
+            })
+        );
+        assert_eq!(score.end_s, 2.0);
+    }
+
+    #[test]
+    fn demo_ends_after_the_arpeggio() {
+        let demo = Score::demo();
+        assert_eq!(demo.end_s, 11.5);
+        assert_eq!(demo.events.len(), 22);
+    }
+}

@@ -1,0 +1,193 @@
+//! Engine behaviour with the real tanpura voice: levels, voice allocation, drone timing,
+//! sample accuracy, block-size independence and smoothing.
+
+use super::render::{render, RenderOptions, Score};
+use super::*;
+
+const RATE: f64 = 44_100.0;
+
+fn note_on(offset: usize, note: u8) -> TimedEvent {
+    TimedEvent {
+        offset,
+        event: EngineEvent::NoteOn {
+            note,
+            velocity: 1.0,
+        },
+    }
+}
+
+fn run(engine: &mut Engine, events: &[TimedEvent], samples: usize) -> Vec<f32> {
+    let mut output = vec![0.0; samples];
+    engine.process(events, &mut output);
+    output
+}
+
+fn peak(signal: &[f32]) -> f32 {
+    signal.iter().fold(0.0, |peak, x| peak.max(x.abs()))
+}
+
+#[test]
+fn default_pluck_peaks_near_minus_12_dbfs() {
+    // Note 54 (185.0 Hz) is the equal-tempered note nearest the reference string's pitch; the
+    // pitch level factor makes the result independent of which note is used anyway.
+    let mut engine = Engine::new(&EngineSettings::default(), RATE, 1);
+    let output = run(&mut engine, &[note_on(0, 54)], 22_050);
+    let peak_dbfs = 20.0 * f64::from(peak(&output)).log10();
+    println!("default pluck peak: {peak_dbfs:.2} dBFS");
+    assert!((-15.0..=-9.0).contains(&peak_dbfs), "{peak_dbfs} dBFS");
+}
+
+#[test]
+fn level_is_independent_of_pitch_within_6_db() {
+    let mut peaks = Vec::new();
+    for note in [36u8, 60, 84] {
+        let mut engine = Engine::new(&EngineSettings::default(), RATE, 1);
+        let output = run(&mut engine, &[note_on(0, note)], 11_025);
+        peaks.push(20.0 * f64::from(peak(&output)).log10());
+    }
+    println!("peaks at notes 36, 60, 84: {peaks:?} dBFS");
+    let spread = peaks.iter().cloned().fold(f64::MIN, f64::max)
+        - peaks.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(spread < 6.0, "{peaks:?}");
+}
+
+#[test]
+fn output_is_exactly_silent_before_a_note_and_sounds_from_its_sample() {
+    let mut engine = Engine::new(&EngineSettings::default(), RATE, 2);
+    let output = run(&mut engine, &[note_on(300, 57)], 2_000);
+    assert!(output[..300].iter().all(|x| *x == 0.0));
+    // The decimator's group delay (about 29 samples at 4×) sets when the pluck shows.
+    let onset = output.iter().position(|x| x.abs() > 1e-3).unwrap();
+    assert!((300..300 + 45).contains(&onset), "onset at {onset}");
+}
+
+#[test]
+fn same_note_replucks_its_string_and_new_notes_take_silent_voices() {
+    let mut engine = Engine::new(&EngineSettings::default(), RATE, 3);
+    run(&mut engine, &[note_on(0, 60), note_on(10, 64)], 64);
+    assert_eq!(engine.active_voices(), 2);
+    assert_eq!(engine.slots[0].key, Some(StringKey::Note(60)));
+    assert_eq!(engine.slots[1].key, Some(StringKey::Note(64)));
+    run(&mut engine, &[note_on(0, 60)], 64);
+    assert_eq!(
+        engine.active_voices(),
+        2,
+        "C4 is plucked again on its own string"
+    );
+    assert_eq!(engine.slots[0].plucked_at, 64);
+}
+
+#[test]
+fn note_off_does_not_stop_a_ringing_string() {
+    let mut engine = Engine::new(&EngineSettings::default(), RATE, 1);
+    let off = TimedEvent {
+        offset: 100,
+        event: EngineEvent::NoteOff { note: 60 },
+    };
+    let output = run(&mut engine, &[note_on(0, 60), off], 4_410);
+    assert!(peak(&output[4_000..]) > 0.01);
+    assert!(engine.active_voices() == 1);
+}
+
+#[test]
+fn stealing_takes_the_quietest_then_the_oldest_voice() {
+    let mut engine = Engine::new(&EngineSettings::default(), RATE, 2);
+    let quiet = TimedEvent {
+        offset: 0,
+        event: EngineEvent::NoteOn {
+            note: 60,
+            velocity: 0.1,
+        },
+    };
+    // C4 quietly, then E4 loudly 0.3 s later; after another 0.3 s G4 needs a voice.
+    run(&mut engine, &[quiet], 13_230);
+    run(&mut engine, &[note_on(0, 64)], 13_230);
+    assert!(engine.slots[0].level < engine.slots[1].level);
+    run(&mut engine, &[note_on(0, 67)], 64);
+    assert_eq!(
+        engine.slots[0].key,
+        Some(StringKey::Note(67)),
+        "quiet C4 stolen"
+    );
+    assert_eq!(engine.slots[1].key, Some(StringKey::Note(64)));
+}
+
+#[test]
+fn drone_plucks_the_four_strings_in_the_cycle_at_the_host_tempo() {
+    let mut settings = EngineSettings::default();
+    settings.drone.enabled = true;
+    let mut engine = Engine::new(&settings, RATE, 4);
+    engine.set_host_tempo(Some(120.0)); // one beat = 22 050 samples
+    run(&mut engine, &[note_on(0, 48)], 22_050);
+    assert_eq!(engine.active_voices(), 1);
+    assert_eq!(engine.slots[0].key, Some(StringKey::Drone(0)));
+    let sa_hz = pitch::note_to_hz(48);
+    assert_eq!(engine.slots[0].fundamental_hz, sa_hz * 0.75);
+    run(&mut engine, &[], 1);
+    assert_eq!(engine.active_voices(), 2, "Sa plucked at exactly one beat");
+    run(&mut engine, &[], 2 * 22_050);
+    assert_eq!(engine.active_voices(), 4);
+    assert_eq!(engine.slots[3].fundamental_hz, sa_hz * 0.5);
+    assert_eq!(engine.slots[3].plucked_at, 3 * 22_050);
+}
+
+#[test]
+fn drone_without_host_tempo_uses_the_free_tempo() {
+    let mut settings = EngineSettings::default();
+    settings.drone.enabled = true;
+    settings.drone.free_tempo_bpm = 90.0; // 29 400 samples per beat
+    let mut engine = Engine::new(&settings, RATE, 4);
+    run(&mut engine, &[note_on(5, 50)], 29_405);
+    assert_eq!(engine.active_voices(), 1);
+    run(&mut engine, &[], 1);
+    assert_eq!(engine.active_voices(), 2);
+    assert_eq!(engine.slots[1].plucked_at, 29_405);
+}
+
+#[test]
+fn block_size_does_not_change_the_output() {
+    let mut score = Score::default();
+    score.note(0.0, 0.1, 57, 1.0);
+    score.note(0.0123, 0.1, 64, 0.6);
+    let mut settings = EngineSettings::default();
+    settings.drone.enabled = false;
+    let options = |block_size| RenderOptions {
+        block_size,
+        tail_s: 0.1,
+        voice_count: 2,
+        ..RenderOptions::default()
+    };
+    let reference = render(&settings, &score, &options(4096), &mut |_, _| {});
+    for block_size in [1, 37, 64] {
+        let other = render(&settings, &score, &options(block_size), &mut |_, _| {});
+        assert_eq!(other, reference, "block size {block_size}");
+    }
+}
+
+#[test]
+fn settings_glide_to_their_targets_in_the_smoothing_time() {
+    let mut engine = Engine::new(&EngineSettings::default(), RATE, 1);
+    run(&mut engine, &[note_on(0, 60)], 64);
+    let mut settings = EngineSettings::default();
+    settings.voice.bridge_stiffness_n_m2 = 1e10;
+    settings.voice.gamma_per_s = 2.0;
+    engine.set_settings(&settings);
+    run(&mut engine, &[], 32);
+    let midway = engine.current_voice;
+    assert!(midway.gamma_per_s > 0.6 && midway.gamma_per_s < 2.0);
+    assert!(midway.bridge_stiffness_n_m2 > 1e8 && midway.bridge_stiffness_n_m2 < 1e10);
+    run(&mut engine, &[], (SMOOTHING_TIME_S * RATE) as usize + 64);
+    assert_eq!(engine.current_voice.gamma_per_s, 2.0);
+    let stiffness = engine.current_voice.bridge_stiffness_n_m2;
+    assert!((stiffness / 1e10 - 1.0).abs() < 1e-12, "{stiffness}");
+    assert_eq!(engine.slots[0].voice.settings().gamma_per_s, 2.0);
+}
+
+#[test]
+fn reset_renders_exactly_as_a_new_engine() {
+    let mut engine = Engine::new(&EngineSettings::default(), RATE, 2);
+    let first = run(&mut engine, &[note_on(3, 62)], 1_000);
+    engine.reset();
+    let second = run(&mut engine, &[note_on(3, 62)], 1_000);
+    assert_eq!(first, second);
+}

@@ -1,0 +1,253 @@
+//! Javari as a CLAP and VST3 instrument (and a standalone app with the `standalone` feature).
+//!
+//! The plugin is a thin wrapper: it turns the host's parameters into engine settings
+//! ([`params`]), its note events into [`TimedEvent`]s, and hands both to the same
+//! [`javari_core::engine::Engine`] that `cargo xtask render` drives. The engine splits the block
+//! at every event, so events are sample-accurate.
+//!
+//! MIDI: note-on plucks the string tuned to that note (12-TET, A4 = 440 Hz) with the pluck
+//! amplitude scaled by velocity; note-off releases the note (the string rings on; in drone mode
+//! releasing the last held note stops the cycle); CC 120 silences every string; CC 123 releases
+//! every note. The output is stereo with the same signal on both channels.
+
+pub mod params;
+
+use javari_core::engine::preset::Preset;
+use javari_core::engine::render::DEFAULT_VOICE_COUNT;
+use javari_core::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
+use nice_plug::midi::Key;
+use nice_plug::prelude::*;
+use params::JavariParams;
+use std::num::NonZeroU32;
+use std::sync::Arc;
+
+/// The factory presets, compiled in from `presets/` (the files `render --preset` reads).
+pub const FACTORY_PRESET_FILES: [(&str, &str); 4] = [
+    (
+        "presets/classic.toml",
+        include_str!("../../presets/classic.toml"),
+    ),
+    (
+        "presets/no-thread.toml",
+        include_str!("../../presets/no-thread.toml"),
+    ),
+    (
+        "presets/bright-jawari.toml",
+        include_str!("../../presets/bright-jawari.toml"),
+    ),
+    ("presets/soft.toml", include_str!("../../presets/soft.toml")),
+];
+
+/// Parses the compiled-in factory presets (a test checks that they parse).
+pub fn factory_presets() -> [Preset; 4] {
+    FACTORY_PRESET_FILES.map(|(file, text)| {
+        Preset::parse(text, file).unwrap_or_else(|_| Preset {
+            name: file.to_string(),
+            settings: EngineSettings::default(),
+        })
+    })
+}
+
+/// Most note events handled in one block (the wrapper's own queue holds as many).
+const EVENT_CAPACITY: usize = 1024;
+
+pub struct Javari {
+    params: Arc<JavariParams>,
+    factory: [Preset; 4],
+    /// Built in `activate` (it allocates the strings); `None` before.
+    engine: Option<Engine>,
+    events: Vec<TimedEvent>,
+    mono: Vec<f32>,
+}
+
+impl Default for Javari {
+    fn default() -> Self {
+        Self {
+            params: Arc::new(JavariParams::default()),
+            factory: factory_presets(),
+            engine: None,
+            events: Vec::with_capacity(EVENT_CAPACITY),
+            mono: Vec::new(),
+        }
+    }
+}
+
+impl Plugin for Javari {
+    const NAME: &'static str = "Javari";
+    const VENDOR: &'static str = "Javari developers";
+    const URL: &'static str = "https://example.invalid/javari";
+    const EMAIL: &'static str = "javari@example.invalid";
+    const VERSION: &'static str = env!("CARGO_PKG_VERSION");
+
+    const AUDIO_IO_LAYOUTS: &'static [AudioIOLayout] = &[AudioIOLayout {
+        main_input_channels: None,
+        main_output_channels: NonZeroU32::new(2),
+        ..AudioIOLayout::const_default()
+    }];
+    const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
+    const SAMPLE_ACCURATE_AUTOMATION: bool = false;
+    const INPUT_EVENT_CAPACITY: usize = EVENT_CAPACITY;
+
+    type Editor = ();
+    type SysExMessage = ();
+    type BackgroundTask = ();
+
+    fn params(&self) -> Arc<dyn Params> {
+        self.params.clone()
+    }
+
+    fn activate(
+        &mut self,
+        _audio_io_layout: &AudioIOLayout,
+        buffer_config: &BufferConfig,
+        _context: &mut impl ActivateContext<Self>,
+    ) -> bool {
+        let settings = self.params.engine_settings(&self.factory);
+        let rate = f64::from(buffer_config.sample_rate);
+        let rebuild = self
+            .engine
+            .as_ref()
+            .is_none_or(|engine| engine.sample_rate_hz() != rate);
+        if rebuild {
+            self.engine = Some(Engine::new(&settings, rate, DEFAULT_VOICE_COUNT));
+        }
+        self.mono
+            .resize(buffer_config.max_buffer_size.max(1) as usize, 0.0);
+        true
+    }
+
+    fn reset(&mut self) {
+        let settings = self.params.engine_settings(&self.factory);
+        if let Some(engine) = &mut self.engine {
+            engine.set_settings(&settings);
+            engine.reset();
+        }
+    }
+
+    fn process(
+        &mut self,
+        buffer: &mut Buffer,
+        _aux: &mut AuxiliaryBuffers,
+        context: &mut impl ProcessContext<Self>,
+    ) -> ProcessStatus {
+        let Some(engine) = &mut self.engine else {
+            return ProcessStatus::Error("process called before activate");
+        };
+        engine.set_settings(&self.params.engine_settings(&self.factory));
+        engine.set_host_tempo(context.transport().tempo);
+
+        self.events.clear();
+        while let Some(event) = context.next_event() {
+            let offset = event.timing() as usize;
+            let engine_event = match event {
+                NoteEvent::NoteOn {
+                    key: Key::Number(note),
+                    velocity,
+                    ..
+                } => EngineEvent::NoteOn { note, velocity },
+                NoteEvent::NoteOff {
+                    key: Key::Number(note),
+                    ..
+                } => EngineEvent::NoteOff { note },
+                // A CLAP wildcard note-off releases every note.
+                NoteEvent::NoteOff {
+                    key: Key::Wildcard, ..
+                } => EngineEvent::AllNotesOff,
+                NoteEvent::MidiCC { cc: 120, .. } => EngineEvent::AllSoundOff,
+                NoteEvent::MidiCC { cc: 123, .. } => EngineEvent::AllNotesOff,
+                _ => continue,
+            };
+            if self.events.len() < self.events.capacity() {
+                self.events.push(TimedEvent {
+                    offset,
+                    event: engine_event,
+                });
+            }
+        }
+
+        let samples = buffer.samples();
+        // Hosts may pass longer buffers than announced; render those in announced-size chunks
+        // so that nothing is allocated here.
+        let chunk = self.mono.len().max(1);
+        let channels = buffer.as_slice();
+        let mut start = 0;
+        let mut next_event = 0;
+        while start < samples {
+            let end = (start + chunk).min(samples);
+            let first_event = next_event;
+            while next_event < self.events.len() && self.events[next_event].offset < end {
+                self.events[next_event].offset -= start.min(self.events[next_event].offset);
+                next_event += 1;
+            }
+            let mono = &mut self.mono[..end - start];
+            engine.process(&self.events[first_event..next_event], mono);
+            for channel in channels.iter_mut() {
+                channel[start..end].copy_from_slice(mono);
+            }
+            start = end;
+        }
+        ProcessStatus::KeepAlive
+    }
+}
+
+impl ClapPlugin for Javari {
+    const CLAP_ID: &'static str = "org.javari.tanpura";
+    const CLAP_DESCRIPTION: Option<&'static str> =
+        Some("Physically modelled tanpura: strings colliding with a curved bridge and a thread");
+    const CLAP_MANUAL_URL: Option<&'static str> = None;
+    const CLAP_SUPPORT_URL: Option<&'static str> = None;
+    const CLAP_FEATURES: &'static [ClapFeature] = &[
+        ClapFeature::Instrument,
+        ClapFeature::Synthesizer,
+        ClapFeature::Stereo,
+    ];
+}
+
+impl Vst3Plugin for Javari {
+    const VST3_CLASS_ID: [u8; 16] = *b"JavariTanpura001";
+    const VST3_SUBCATEGORIES: &'static [Vst3SubCategory] =
+        &[Vst3SubCategory::Instrument, Vst3SubCategory::Synth];
+}
+
+nice_export_clap!(Javari);
+nice_export_vst3!(Javari);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn factory_presets_parse_and_have_their_names() {
+        let names: Vec<String> = FACTORY_PRESET_FILES
+            .iter()
+            .map(|(file, text)| Preset::parse(text, file).unwrap().name)
+            .collect();
+        assert_eq!(names, ["Classic", "No thread", "Bright jawari", "Soft"]);
+    }
+
+    #[test]
+    fn default_parameters_give_the_default_engine_settings() {
+        let params = JavariParams::default();
+        let settings = params.engine_settings(&factory_presets());
+        let expected = EngineSettings::default();
+        assert_eq!(settings.pluck.width_m, expected.pluck.width_m);
+        assert!((settings.voice.bridge_stiffness_n_m2 / 1e8 - 1.0).abs() < 1e-6);
+        assert!((settings.voice.thread_position_m - 0.040).abs() < 1e-9);
+        assert!((settings.voice.eta_s / 7e-9 - 1.0).abs() < 1e-6);
+        assert_eq!(settings.voice.quality, javari_core::quality::Quality::Live);
+        assert_eq!(settings.drone, expected.drone);
+    }
+
+    #[test]
+    fn classic_preset_matches_the_default_sound() {
+        let classic = &factory_presets()[0].settings;
+        let default = EngineSettings::default();
+        assert_eq!(classic.voice, default.voice);
+        assert_eq!(
+            classic.voice.quality,
+            javari_core::quality::Quality::Reference,
+            "a preset without a quality key keeps the default tier"
+        );
+        assert_eq!(classic.pluck, default.pluck);
+    }
+}

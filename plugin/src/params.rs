@@ -1,0 +1,300 @@
+//! The plugin's parameters: stable short IDs, units, ranges, and their mapping onto the engine's
+//! SI settings. This is the only place where host-facing units (mm, ns, decades) appear.
+//!
+//! Smoothing happens in the engine, in SI units (`javari_core::engine`, 20 ms ramps at a control
+//! rate), so the host parameters carry no smoother of their own.
+//!
+//! | ID | name | unit | range | default | meaning |
+//! |---|---|---|---|---|---|
+//! | `preset` | Preset | | Custom, Classic, No thread, Bright jawari, Soft | Custom | factory preset; anything but Custom overrides the sound parameters below (not gain) |
+//! | `thon` | Thread | on/off | | on | cotton thread (jawari) between string and bridge |
+//! | `thpos` | Thread position | mm | 30–45 | 40 | thread distance from the tuning bead |
+//! | `kb` | Bridge stiffness | log10(N/m²) | 5–11 | 8 | k_b = 10^value N/m² (log scale) |
+//! | `brbt` | Bridge beyond thread | on/off | | on | off: k_b = 0 past the thread |
+//! | `gamma` | Damping | 1/s | 0–20 | 0.6 | γ, frequency-independent loss (sustain) |
+//! | `eta` | HF damping | ns | 0–1000 | 7 | η, frequency-dependent loss (darkness) |
+//! | `plpos` | Pluck position | mm | 50–600 | 350 | pluck point from the tuning bead |
+//! | `plwid` | Pluck width | mm | 2–40 | 10 | fingertip width |
+//! | `plamp` | Pluck amplitude | mm | 0–5 | 2 | finger lift at full velocity |
+//! | `pick` | Pickup | % nut | 0–100 | 100 | 100: nut force, 0: bridge force |
+//! | `qual` | Quality | | Draft, Live, Studio, Reference | Live | the core's tiers (`core/src/quality.rs`); not part of the factory presets |
+//! | `gain` | Output gain | dB | −60–24 | 0 | after 2 N = full scale |
+//! | `drone` | Drone | on/off | | off | a held note sets Sa and the strings play the cycle |
+//! | `first` | First string | | Pa, Ma, Ni | Pa | first drone string: 3/4, 2/3 or 15/16 of Sa |
+//! | `dsync` | Drone tempo sync | on/off | | on | follow the host's tempo |
+//! | `dbpm` | Drone tempo | bpm | 20–300 | 60 | tempo without sync |
+
+use javari_core::engine::drone::TEMPO_RANGE_BPM;
+use javari_core::engine::preset::{Preset, PLUCK_POSITION_RANGE_M};
+use javari_core::engine::{EngineSettings, OUTPUT_GAIN_RANGE_DB};
+use javari_core::excitation::Pluck;
+use javari_core::quality::Quality;
+use javari_core::tanpura::{FirstString, VoiceSettings};
+use javari_core::tanpura_string::ThreadSettings;
+use nice_plug::prelude::*;
+use std::sync::Arc;
+
+/// Factory preset selector. `Custom` plays the knobs.
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PresetChoice {
+    #[id = "custom"]
+    Custom,
+    #[id = "classic"]
+    Classic,
+    #[id = "no-thread"]
+    #[name = "No thread"]
+    NoThread,
+    #[id = "bright-jawari"]
+    #[name = "Bright jawari"]
+    BrightJawari,
+    #[id = "soft"]
+    Soft,
+}
+
+/// The core's quality tiers (`core/src/quality.rs`), cheapest first.
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum QualityChoice {
+    #[id = "draft"]
+    Draft,
+    #[id = "live"]
+    Live,
+    #[id = "studio"]
+    Studio,
+    #[id = "reference"]
+    Reference,
+}
+
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FirstStringChoice {
+    #[id = "pa"]
+    Pa,
+    #[id = "ma"]
+    Ma,
+    #[id = "ni"]
+    Ni,
+}
+
+const MM_PER_M: f64 = 1000.0;
+const NS_PER_S: f64 = 1e9;
+
+fn millimetres(range_m: (f64, f64)) -> FloatRange {
+    FloatRange::Linear {
+        min: (range_m.0 * MM_PER_M) as f32,
+        max: (range_m.1 * MM_PER_M) as f32,
+    }
+}
+
+#[derive(Params)]
+pub struct JavariParams {
+    #[id = "preset"]
+    pub preset: EnumParam<PresetChoice>,
+    #[id = "thon"]
+    pub thread_enabled: BoolParam,
+    #[id = "thpos"]
+    pub thread_position_mm: FloatParam,
+    #[id = "kb"]
+    pub bridge_stiffness_log10: FloatParam,
+    #[id = "brbt"]
+    pub bridge_beyond_thread: BoolParam,
+    #[id = "gamma"]
+    pub gamma_per_s: FloatParam,
+    #[id = "eta"]
+    pub eta_ns: FloatParam,
+    #[id = "plpos"]
+    pub pluck_position_mm: FloatParam,
+    #[id = "plwid"]
+    pub pluck_width_mm: FloatParam,
+    #[id = "plamp"]
+    pub pluck_amplitude_mm: FloatParam,
+    #[id = "pick"]
+    pub nut_pickup_percent: FloatParam,
+    #[id = "qual"]
+    pub quality: EnumParam<QualityChoice>,
+    #[id = "gain"]
+    pub output_gain_db: FloatParam,
+    #[id = "drone"]
+    pub drone_enabled: BoolParam,
+    #[id = "first"]
+    pub drone_first_string: EnumParam<FirstStringChoice>,
+    #[id = "dsync"]
+    pub drone_tempo_sync: BoolParam,
+    #[id = "dbpm"]
+    pub drone_tempo_bpm: FloatParam,
+}
+
+impl Default for JavariParams {
+    fn default() -> Self {
+        let voice = VoiceSettings::default();
+        let pluck = Pluck::default();
+        Self {
+            preset: EnumParam::new("Preset", PresetChoice::Custom),
+            thread_enabled: BoolParam::new("Thread", voice.thread_enabled),
+            thread_position_mm: FloatParam::new(
+                "Thread position",
+                (voice.thread_position_m * MM_PER_M) as f32,
+                millimetres(ThreadSettings::POSITION_RANGE_M),
+            )
+            .with_unit(" mm")
+            .with_step_size(0.01),
+            bridge_stiffness_log10: FloatParam::new(
+                "Bridge stiffness",
+                voice.bridge_stiffness_n_m2.log10() as f32,
+                FloatRange::Linear {
+                    min: BRIDGE_STIFFNESS_LOG10_RANGE.0,
+                    max: BRIDGE_STIFFNESS_LOG10_RANGE.1,
+                },
+            )
+            .with_value_to_string(Arc::new(|log10| {
+                format!("{:.2e} N/m²", 10f64.powf(f64::from(log10)))
+            }))
+            .with_string_to_value(Arc::new(|text| {
+                let number: f64 = text.trim().trim_end_matches("N/m²").trim().parse().ok()?;
+                (number > 0.0).then(|| number.log10() as f32)
+            })),
+            bridge_beyond_thread: BoolParam::new(
+                "Bridge beyond thread",
+                voice.bridge_beyond_thread,
+            ),
+            gamma_per_s: FloatParam::new(
+                "Damping",
+                voice.gamma_per_s as f32,
+                FloatRange::Skewed {
+                    min: VoiceSettings::GAMMA_RANGE.0 as f32,
+                    max: VoiceSettings::GAMMA_RANGE.1 as f32,
+                    factor: FloatRange::skew_factor(-2.0),
+                },
+            )
+            .with_unit(" 1/s")
+            .with_step_size(0.001),
+            eta_ns: FloatParam::new(
+                "HF damping",
+                (voice.eta_s * NS_PER_S) as f32,
+                FloatRange::Skewed {
+                    min: (VoiceSettings::ETA_RANGE.0 * NS_PER_S) as f32,
+                    max: (VoiceSettings::ETA_RANGE.1 * NS_PER_S) as f32,
+                    factor: FloatRange::skew_factor(-2.0),
+                },
+            )
+            .with_unit(" ns")
+            .with_step_size(0.01),
+            pluck_position_mm: FloatParam::new(
+                "Pluck position",
+                (pluck.position_m * MM_PER_M) as f32,
+                millimetres(PLUCK_POSITION_RANGE_M),
+            )
+            .with_unit(" mm")
+            .with_step_size(0.1),
+            pluck_width_mm: FloatParam::new(
+                "Pluck width",
+                (pluck.width_m * MM_PER_M) as f32,
+                millimetres(Pluck::WIDTH_RANGE_M),
+            )
+            .with_unit(" mm")
+            .with_step_size(0.1),
+            pluck_amplitude_mm: FloatParam::new(
+                "Pluck amplitude",
+                (pluck.amplitude_m * MM_PER_M) as f32,
+                millimetres(Pluck::AMPLITUDE_RANGE_M),
+            )
+            .with_unit(" mm")
+            .with_step_size(0.01),
+            nut_pickup_percent: FloatParam::new(
+                "Pickup",
+                (voice.nut_pickup_weight * 100.0) as f32,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: 100.0,
+                },
+            )
+            .with_unit(" % nut")
+            .with_step_size(0.1),
+            // Live by default: a DAW needs real time; the renderer defaults to Reference.
+            quality: EnumParam::new("Quality", QualityChoice::Live),
+            output_gain_db: FloatParam::new(
+                "Output gain",
+                0.0,
+                FloatRange::Linear {
+                    min: OUTPUT_GAIN_RANGE_DB.0 as f32,
+                    max: OUTPUT_GAIN_RANGE_DB.1 as f32,
+                },
+            )
+            .with_unit(" dB")
+            .with_step_size(0.1),
+            drone_enabled: BoolParam::new("Drone", false),
+            drone_first_string: EnumParam::new("First string", FirstStringChoice::Pa),
+            drone_tempo_sync: BoolParam::new("Drone tempo sync", true),
+            drone_tempo_bpm: FloatParam::new(
+                "Drone tempo",
+                60.0,
+                FloatRange::Linear {
+                    min: TEMPO_RANGE_BPM.0 as f32,
+                    max: TEMPO_RANGE_BPM.1 as f32,
+                },
+            )
+            .with_unit(" bpm")
+            .with_step_size(0.1),
+        }
+    }
+}
+
+/// Range of the `kb` parameter: k_b from 1e5 to 1e11 N/m² (a soft to a very hard bridge).
+pub const BRIDGE_STIFFNESS_LOG10_RANGE: (f32, f32) = (5.0, 11.0);
+
+impl JavariParams {
+    /// The engine settings the parameters describe; a factory preset other than `Custom`
+    /// replaces the sound (every parameter but quality, output gain and the drone controls).
+    pub fn engine_settings(&self, factory: &[Preset; 4]) -> EngineSettings {
+        let gain_db = f64::from(self.output_gain_db.value());
+        let drone_from_knobs = javari_core::engine::drone::DroneSettings {
+            enabled: self.drone_enabled.value(),
+            first_string: match self.drone_first_string.value() {
+                FirstStringChoice::Pa => FirstString::Pa,
+                FirstStringChoice::Ma => FirstString::Ma,
+                FirstStringChoice::Ni => FirstString::Ni,
+            },
+            tempo_sync: self.drone_tempo_sync.value(),
+            free_tempo_bpm: f64::from(self.drone_tempo_bpm.value()),
+        };
+        let preset = match self.preset.value() {
+            PresetChoice::Custom => None,
+            PresetChoice::Classic => Some(&factory[0]),
+            PresetChoice::NoThread => Some(&factory[1]),
+            PresetChoice::BrightJawari => Some(&factory[2]),
+            PresetChoice::Soft => Some(&factory[3]),
+        };
+        let quality = match self.quality.value() {
+            QualityChoice::Draft => Quality::Draft,
+            QualityChoice::Live => Quality::Live,
+            QualityChoice::Studio => Quality::Studio,
+            QualityChoice::Reference => Quality::Reference,
+        };
+        if let Some(preset) = preset {
+            let mut settings = preset.settings;
+            settings.voice.quality = quality;
+            settings.output_gain_db += gain_db;
+            settings.drone = drone_from_knobs;
+            return settings;
+        }
+        let voice = VoiceSettings {
+            thread_enabled: self.thread_enabled.value(),
+            thread_position_m: f64::from(self.thread_position_mm.value()) / MM_PER_M,
+            bridge_stiffness_n_m2: 10f64.powf(f64::from(self.bridge_stiffness_log10.value())),
+            bridge_beyond_thread: self.bridge_beyond_thread.value(),
+            gamma_per_s: f64::from(self.gamma_per_s.value()),
+            eta_s: f64::from(self.eta_ns.value()) / NS_PER_S,
+            nut_pickup_weight: f64::from(self.nut_pickup_percent.value()) / 100.0,
+            quality,
+            ..VoiceSettings::default()
+        };
+        EngineSettings {
+            voice,
+            pluck: Pluck {
+                position_m: f64::from(self.pluck_position_mm.value()) / MM_PER_M,
+                width_m: f64::from(self.pluck_width_mm.value()) / MM_PER_M,
+                amplitude_m: f64::from(self.pluck_amplitude_mm.value()) / MM_PER_M,
+            },
+            output_gain_db: gain_db,
+            drone: drone_from_knobs,
+        }
+    }
+}

@@ -1,0 +1,238 @@
+//! The built `.clap` (the `javari` cdylib that `cargo test` leaves in `target/<profile>/deps/`)
+//! loaded by a CLAP host written with `clack-host`, as a DAW would: activate at several sample
+//! rates and block sizes, play a note, check the pitch while it rings and that every sample is
+//! finite, and round-trip the plugin state. The cdylib is built with `assert_process_allocs`,
+//! so an allocation in `process` aborts this test.
+
+use clack_extensions::state::PluginState;
+use clack_host::events::event_types::NoteOnEvent;
+use clack_host::prelude::*;
+use javari_core::engine::pitch::{cents, note_to_hz};
+use javari_tests::{peak, peak_frequency_near, plugin_library};
+
+struct TestHostShared;
+
+impl SharedHandler<'_> for TestHostShared {
+    fn request_restart(&self) {}
+    fn request_process(&self) {}
+    fn request_callback(&self) {}
+}
+
+struct TestHost;
+
+impl HostHandlers for TestHost {
+    type Shared<'a> = TestHostShared;
+    type MainThread<'a> = ();
+    type AudioProcessor<'a> = ();
+}
+
+const PLUGIN_ID: &[u8] = b"org.javari.tanpura";
+
+fn load_entry() -> PluginEntry {
+    let library = plugin_library();
+    // SAFETY: the library is this repository's own plugin, built by this `cargo test`.
+    unsafe { PluginEntry::load(&library) }
+        .unwrap_or_else(|error| panic!("loading {}: {error:?}", library.display()))
+}
+
+fn instantiate(entry: &PluginEntry) -> PluginInstance<TestHost> {
+    let host_info = HostInfo::new("javari-tests", "Javari", "https://example.invalid", "1.0")
+        .expect("valid host info");
+    let factory = entry.get_plugin_factory().expect("a plugin factory");
+    let descriptor = factory
+        .plugin_descriptors()
+        .find(|descriptor| descriptor.id().map(|id| id.to_bytes()) == Some(PLUGIN_ID))
+        .expect("the Javari descriptor");
+    assert_eq!(descriptor.name().unwrap().to_bytes(), b"Javari");
+    let id = descriptor.id().unwrap();
+    PluginInstance::<TestHost>::new(|_| TestHostShared, |_| (), entry, id, &host_info)
+        .expect("instantiation")
+}
+
+/// Plays `key` at `velocity` from sample `note_at` for `seconds`, in blocks of `block_size`;
+/// returns the left and right channels.
+fn play(
+    instance: &mut PluginInstance<TestHost>,
+    sample_rate: f64,
+    block_size: usize,
+    key: u16,
+    velocity: f64,
+    note_at: usize,
+    seconds: f64,
+) -> (Vec<f32>, Vec<f32>) {
+    let configuration = PluginAudioConfiguration {
+        sample_rate,
+        min_frames_count: 1,
+        max_frames_count: block_size as u32,
+    };
+    let processor = instance
+        .activate(|_, _| (), configuration)
+        .expect("activation");
+    let mut processor = processor.start_processing().expect("start processing");
+    let total = (seconds * sample_rate) as usize;
+    let mut left = Vec::with_capacity(total);
+    let mut right = Vec::with_capacity(total);
+    let mut input_ports = AudioPorts::with_capacity(0, 0);
+    let mut output_ports = AudioPorts::with_capacity(2, 1);
+    let mut output_events = EventBuffer::new();
+    let mut buffers = [vec![0.0f32; block_size], vec![0.0f32; block_size]];
+    let mut start = 0;
+    while start < total {
+        let frames = block_size.min(total - start);
+        let note_in_block = (start..start + frames).contains(&note_at);
+        let events = if note_in_block {
+            vec![NoteOnEvent::new(
+                (note_at - start) as u32,
+                Pckn::new(0u16, 0u16, key, 0u32),
+                velocity,
+            )]
+        } else {
+            Vec::new()
+        };
+        let input_events = InputEvents::from_buffer(&events);
+        let mut output_events = OutputEvents::from_buffer(&mut output_events);
+        let input_audio = input_ports.with_input_buffers(std::iter::empty::<
+            AudioPortBuffer<
+                std::iter::Empty<InputChannel<f32>>,
+                std::iter::Empty<InputChannel<f64>>,
+            >,
+        >());
+        let [buffer_left, buffer_right] = &mut buffers;
+        let mut output_audio = output_ports.with_output_buffers([AudioPortBuffer {
+            latency: 0,
+            channels: AudioPortBufferType::f32_output_only(
+                [&mut buffer_left[..frames], &mut buffer_right[..frames]].into_iter(),
+            ),
+        }]);
+        processor
+            .process(
+                &input_audio,
+                &mut output_audio,
+                &input_events,
+                &mut output_events,
+                None,
+                None,
+            )
+            .expect("process");
+        left.extend_from_slice(&buffers[0][..frames]);
+        right.extend_from_slice(&buffers[1][..frames]);
+        start += frames;
+    }
+    let processor = processor.stop_processing();
+    instance.deactivate(processor);
+    (left, right)
+}
+
+#[test]
+fn clap_plays_in_tune_at_several_rates_and_block_sizes() {
+    let entry = load_entry();
+    let key = 57u16; // A3, 220 Hz
+    for (sample_rate, block_size) in [(44_100.0, 512usize), (48_000.0, 33), (96_000.0, 1024)] {
+        let mut instance = instantiate(&entry);
+        let note_at = 100;
+        let (left, right) = play(
+            &mut instance,
+            sample_rate,
+            block_size,
+            key,
+            0.4,
+            note_at,
+            0.6,
+        );
+        assert!(left.iter().all(|x| x.is_finite()), "non-finite sample");
+        assert_eq!(left, right, "both channels carry the string");
+        assert!(peak(&left[..note_at]) == 0.0, "silent before the note");
+        let ringing = &left[(0.1 * sample_rate) as usize..];
+        let level = peak(ringing);
+        assert!(level > 1e-3 && level < 1.0, "level {level}");
+        let expected = note_to_hz(key as u8);
+        let measured = peak_frequency_near(ringing, sample_rate, expected, 60.0);
+        let error = cents(measured, expected);
+        println!(
+            "{sample_rate} Hz, block {block_size}: {measured:.3} Hz ({error:+.2} cents), peak {level:.3}"
+        );
+        assert!(error.abs() < 5.0, "{error} cents at {sample_rate} Hz");
+    }
+}
+
+#[test]
+fn clap_state_round_trip_restores_parameters() {
+    let entry = load_entry();
+    let mut first = instantiate(&entry);
+    let state_extension = first
+        .plugin_handle()
+        .get_extension::<PluginState>()
+        .expect("the state extension");
+    let mut saved = Vec::new();
+    state_extension
+        .save(&first.plugin_handle(), &mut saved)
+        .expect("save");
+    let text = state_json(&saved);
+    assert!(text.contains("\"gain\""), "parameters by stable ID: {text}");
+
+    // Change the output gain in the saved state (0 dB → −6.02 dB), load it into a fresh
+    // instance, and check that it plays half as loud and saves the new value back.
+    let edited = edit_parameter(&text, "gain", -6.0206);
+    let mut second = instantiate(&entry);
+    let extension = second
+        .plugin_handle()
+        .get_extension::<PluginState>()
+        .unwrap();
+    extension
+        .load(
+            &second.plugin_handle(),
+            &mut state_bytes(&edited).as_slice(),
+        )
+        .expect("load");
+    let mut resaved = Vec::new();
+    extension
+        .save(&second.plugin_handle(), &mut resaved)
+        .expect("save again");
+    let resaved = state_json(&resaved);
+    assert_eq!(parameter_value(&resaved, "gain"), -6.0206);
+    assert_eq!(
+        resaved.replace("-6.0206", "0.0"),
+        text,
+        "every other parameter survives the round trip"
+    );
+
+    let (loud, _) = play(&mut first, 44_100.0, 256, 60, 0.5, 0, 0.2);
+    let (quiet, _) = play(&mut second, 44_100.0, 256, 60, 0.5, 0, 0.2);
+    let ratio = peak(&quiet) / peak(&loud);
+    println!("gain state −6.02 dB: level ratio {ratio:.4}");
+    assert!((ratio - 0.5).abs() < 0.01, "{ratio}");
+}
+
+/// nice-plug's CLAP state: the JSON text's length as a little-endian u64, then the JSON, in
+/// which each parameter is `"id":{"f32":value}` (or `bool`, `string`).
+fn state_json(bytes: &[u8]) -> String {
+    let length = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    assert_eq!(length, bytes.len() - 8, "length prefix");
+    String::from_utf8(bytes[8..].to_vec()).expect("UTF-8 JSON")
+}
+
+fn state_bytes(json: &str) -> Vec<u8> {
+    let mut bytes = (json.len() as u64).to_le_bytes().to_vec();
+    bytes.extend_from_slice(json.as_bytes());
+    bytes
+}
+
+fn parameter_span(text: &str, id: &str) -> (usize, usize) {
+    let key = format!("\"{id}\":{{\"f32\":");
+    let start = text
+        .find(&key)
+        .unwrap_or_else(|| panic!("no {key} in {text}"))
+        + key.len();
+    let end = start + text[start..].find('}').unwrap();
+    (start, end)
+}
+
+fn parameter_value(text: &str, id: &str) -> f64 {
+    let (start, end) = parameter_span(text, id);
+    text[start..end].trim().parse().unwrap()
+}
+
+fn edit_parameter(text: &str, id: &str, value: f64) -> String {
+    let (start, end) = parameter_span(text, id);
+    format!("{}{value}{}", &text[..start], &text[end..])
+}
