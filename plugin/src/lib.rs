@@ -9,6 +9,10 @@
 //! amplitude scaled by velocity; note-off releases the note (the string rings on; in drone mode
 //! releasing the last held note stops the cycle); CC 120 silences every string; CC 123 releases
 //! every note. The output is stereo with the same signal on both channels.
+//!
+//! With the `inst` parameter on Bowed, the same events play one bowed string
+//! (`javari_core::bowed::instrument` documents that mapping): CCs, channel and per-note pressure
+//! and pitch bend reach it too.
 
 pub mod params;
 
@@ -22,7 +26,7 @@ use std::num::NonZeroU32;
 use std::sync::Arc;
 
 /// The factory presets, compiled in from `presets/` (the files `render --preset` reads).
-pub const FACTORY_PRESET_FILES: [(&str, &str); 4] = [
+pub const FACTORY_PRESET_FILES: [(&str, &str); params::FACTORY_PRESET_COUNT] = [
     (
         "presets/classic.toml",
         include_str!("../../presets/classic.toml"),
@@ -36,10 +40,26 @@ pub const FACTORY_PRESET_FILES: [(&str, &str); 4] = [
         include_str!("../../presets/bright-jawari.toml"),
     ),
     ("presets/soft.toml", include_str!("../../presets/soft.toml")),
+    (
+        "presets/bowed-violin.toml",
+        include_str!("../../presets/bowed-violin.toml"),
+    ),
+    (
+        "presets/bowed-cello.toml",
+        include_str!("../../presets/bowed-cello.toml"),
+    ),
+    (
+        "presets/bowed-sul-ponticello.toml",
+        include_str!("../../presets/bowed-sul-ponticello.toml"),
+    ),
+    (
+        "presets/bowed-flautando.toml",
+        include_str!("../../presets/bowed-flautando.toml"),
+    ),
 ];
 
 /// Parses the compiled-in factory presets (a test checks that they parse).
-pub fn factory_presets() -> [Preset; 4] {
+pub fn factory_presets() -> [Preset; params::FACTORY_PRESET_COUNT] {
     FACTORY_PRESET_FILES.map(|(file, text)| {
         Preset::parse(text, file).unwrap_or_else(|_| Preset {
             name: file.to_string(),
@@ -53,7 +73,7 @@ const EVENT_CAPACITY: usize = 1024;
 
 pub struct Javari {
     params: Arc<JavariParams>,
-    factory: [Preset; 4],
+    factory: [Preset; params::FACTORY_PRESET_COUNT],
     /// Built in `activate` (it allocates the strings); `None` before.
     engine: Option<Engine>,
     events: Vec<TimedEvent>,
@@ -155,6 +175,22 @@ impl Plugin for Javari {
                 } => EngineEvent::AllNotesOff,
                 NoteEvent::MidiCC { cc: 120, .. } => EngineEvent::AllSoundOff,
                 NoteEvent::MidiCC { cc: 123, .. } => EngineEvent::AllNotesOff,
+                NoteEvent::MidiCC { cc, value, .. } => {
+                    EngineEvent::Controller { number: cc, value }
+                }
+                NoteEvent::MidiChannelPressure { pressure, .. } => {
+                    EngineEvent::ChannelPressure(pressure)
+                }
+                NoteEvent::PolyPressure {
+                    key: Key::Number(note),
+                    pressure,
+                    ..
+                } => EngineEvent::PolyPressure {
+                    note,
+                    value: pressure,
+                },
+                // nice-plug gives the bend normalised to 0–1 with 0.5 at rest.
+                NoteEvent::MidiPitchBend { value, .. } => EngineEvent::PitchBend(2.0 * value - 1.0),
                 _ => continue,
             };
             if self.events.len() < self.events.capacity() {
@@ -222,7 +258,19 @@ mod tests {
             .iter()
             .map(|(file, text)| Preset::parse(text, file).unwrap().name)
             .collect();
-        assert_eq!(names, ["Classic", "No thread", "Bright jawari", "Soft"]);
+        assert_eq!(
+            names,
+            [
+                "Classic",
+                "No thread",
+                "Bright jawari",
+                "Soft",
+                "Bowed violin",
+                "Bowed cello",
+                "Sul ponticello",
+                "Flautando (bow table)"
+            ]
+        );
     }
 
     #[test]

@@ -6,7 +6,7 @@
 //!
 //! | ID | name | unit | range | default | meaning |
 //! |---|---|---|---|---|---|
-//! | `preset` | Preset | | Custom, Classic, No thread, Bright jawari, Soft | Custom | factory preset; anything but Custom overrides the sound parameters below (not gain) |
+//! | `preset` | Preset | | Custom, Classic, No thread, Bright jawari, Soft, Bowed violin, Bowed cello, Sul ponticello, Flautando | Custom | factory preset; anything but Custom overrides the sound parameters below (not gain) |
 //! | `thon` | Thread | on/off | | on | cotton thread (jawari) between string and bridge |
 //! | `thpos` | Thread position | mm | 30–45 | 40 | thread distance from the tuning bead |
 //! | `kb` | Bridge stiffness | log10(N/m²) | 5–11 | 8 | k_b = 10^value N/m² (log scale) |
@@ -23,10 +23,24 @@
 //! | `first` | First string | | Pa, Ma, Ni | Pa | first drone string: 3/4, 2/3 or 15/16 of Sa |
 //! | `dsync` | Drone tempo sync | on/off | | on | follow the host's tempo |
 //! | `dbpm` | Drone tempo | bpm | 20–300 | 60 | tempo without sync |
+//! | `inst` | Instrument | | Tanpura, Bowed | Tanpura | plucked tanpura strings or one bowed string |
+//! | `bmodel` | Bow model | | Rounded corner, Bow table | Rounded corner | the bowed tier: McIntyre–Schumacher–Woodhouse, or STK's bow table |
+//! | `bstr` | Bowed string | | Violin A, Cello D | Violin A | the bowed string's tension, density and losses |
+//! | `bpres` | Bow pressure | % | 0–100 | 50 | bow force as a fraction of Schelleng's range for the current bow speed and position; MIDI pressure moves it too |
+//! | `bvel` | Bow speed | m/s | 0.02–1 | 0.2 | bow velocity; key velocity and CC 11 move it too |
+//! | `bpos` | Bow position | β | 0.02–0.5 | 0.1 | distance from the bridge over the string length; CC 74 moves it too |
+//! | `glide` | Legato glide | ms | 0–1000 | 80 | glide time between legato notes |
+//! | `vib` | Vibrato depth | cents | 0–100 | 40 | vibrato at full modulation wheel (CC 1) |
+//! | `body` | Body | on/off | | on | the violin-body resonance filter |
 
+use javari_core::bowed::{BowTier, BowedPlayerSettings};
 use javari_core::engine::drone::TEMPO_RANGE_BPM;
-use javari_core::engine::preset::{Preset, PLUCK_POSITION_RANGE_M};
-use javari_core::engine::{EngineSettings, OUTPUT_GAIN_RANGE_DB};
+use javari_core::engine::preset::{
+    Preset, BOW_POSITION_RANGE, BOW_VELOCITY_RANGE_M_S, PLUCK_POSITION_RANGE_M,
+};
+use javari_core::engine::{
+    BowedEngineSettings, BowedStringKind, EngineSettings, Instrument, OUTPUT_GAIN_RANGE_DB,
+};
 use javari_core::excitation::Pluck;
 use javari_core::quality::Quality;
 use javari_core::tanpura::{FirstString, VoiceSettings};
@@ -49,6 +63,46 @@ pub enum PresetChoice {
     BrightJawari,
     #[id = "soft"]
     Soft,
+    #[id = "bowed-violin"]
+    #[name = "Bowed violin"]
+    BowedViolin,
+    #[id = "bowed-cello"]
+    #[name = "Bowed cello"]
+    BowedCello,
+    #[id = "bowed-sul-ponticello"]
+    #[name = "Sul ponticello"]
+    SulPonticello,
+    #[id = "bowed-flautando"]
+    #[name = "Flautando"]
+    Flautando,
+}
+
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InstrumentChoice {
+    #[id = "tanpura"]
+    Tanpura,
+    #[id = "bowed"]
+    Bowed,
+}
+
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BowModelChoice {
+    #[id = "rounded-corner"]
+    #[name = "Rounded corner"]
+    RoundedCorner,
+    #[id = "bow-table"]
+    #[name = "Bow table"]
+    BowTable,
+}
+
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BowedStringChoice {
+    #[id = "violin-a"]
+    #[name = "Violin A"]
+    ViolinA,
+    #[id = "cello-d"]
+    #[name = "Cello D"]
+    CelloD,
 }
 
 /// The core's quality tiers (`core/src/quality.rs`), cheapest first.
@@ -120,12 +174,31 @@ pub struct JavariParams {
     pub drone_tempo_sync: BoolParam,
     #[id = "dbpm"]
     pub drone_tempo_bpm: FloatParam,
+    #[id = "inst"]
+    pub instrument: EnumParam<InstrumentChoice>,
+    #[id = "bmodel"]
+    pub bow_model: EnumParam<BowModelChoice>,
+    #[id = "bstr"]
+    pub bowed_string: EnumParam<BowedStringChoice>,
+    #[id = "bpres"]
+    pub bow_pressure_percent: FloatParam,
+    #[id = "bvel"]
+    pub bow_velocity_m_s: FloatParam,
+    #[id = "bpos"]
+    pub bow_position: FloatParam,
+    #[id = "glide"]
+    pub glide_ms: FloatParam,
+    #[id = "vib"]
+    pub vibrato_cents: FloatParam,
+    #[id = "body"]
+    pub body_enabled: BoolParam,
 }
 
 impl Default for JavariParams {
     fn default() -> Self {
         let voice = VoiceSettings::default();
         let pluck = Pluck::default();
+        let bowed = BowedEngineSettings::default();
         Self {
             preset: EnumParam::new("Preset", PresetChoice::Custom),
             thread_enabled: BoolParam::new("Thread", voice.thread_enabled),
@@ -233,6 +306,62 @@ impl Default for JavariParams {
             )
             .with_unit(" bpm")
             .with_step_size(0.1),
+            instrument: EnumParam::new("Instrument", InstrumentChoice::Tanpura),
+            bow_model: EnumParam::new("Bow model", BowModelChoice::RoundedCorner),
+            bowed_string: EnumParam::new("Bowed string", BowedStringChoice::ViolinA),
+            bow_pressure_percent: FloatParam::new(
+                "Bow pressure",
+                (bowed.pressure * 100.0) as f32,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: 100.0,
+                },
+            )
+            .with_unit(" %")
+            .with_step_size(0.1),
+            bow_velocity_m_s: FloatParam::new(
+                "Bow speed",
+                bowed.bow_velocity_m_s as f32,
+                FloatRange::Skewed {
+                    min: BOW_VELOCITY_RANGE_M_S.0 as f32,
+                    max: BOW_VELOCITY_RANGE_M_S.1 as f32,
+                    factor: FloatRange::skew_factor(-1.0),
+                },
+            )
+            .with_unit(" m/s")
+            .with_step_size(0.001),
+            bow_position: FloatParam::new(
+                "Bow position",
+                bowed.bow_position as f32,
+                FloatRange::Skewed {
+                    min: BOW_POSITION_RANGE.0 as f32,
+                    max: BOW_POSITION_RANGE.1 as f32,
+                    factor: FloatRange::skew_factor(-1.0),
+                },
+            )
+            .with_unit(" β")
+            .with_step_size(0.001),
+            glide_ms: FloatParam::new(
+                "Legato glide",
+                (bowed.player.glide_time_s * 1000.0) as f32,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: 1000.0,
+                },
+            )
+            .with_unit(" ms")
+            .with_step_size(1.0),
+            vibrato_cents: FloatParam::new(
+                "Vibrato depth",
+                bowed.player.max_vibrato_cents as f32,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: 100.0,
+                },
+            )
+            .with_unit(" cents")
+            .with_step_size(0.1),
+            body_enabled: BoolParam::new("Body", bowed.player.body_enabled),
         }
     }
 }
@@ -243,7 +372,7 @@ pub const BRIDGE_STIFFNESS_LOG10_RANGE: (f32, f32) = (5.0, 11.0);
 impl JavariParams {
     /// The engine settings the parameters describe; a factory preset other than `Custom`
     /// replaces the sound (every parameter but quality, output gain and the drone controls).
-    pub fn engine_settings(&self, factory: &[Preset; 4]) -> EngineSettings {
+    pub fn engine_settings(&self, factory: &[Preset; FACTORY_PRESET_COUNT]) -> EngineSettings {
         let gain_db = f64::from(self.output_gain_db.value());
         let drone_from_knobs = javari_core::engine::drone::DroneSettings {
             enabled: self.drone_enabled.value(),
@@ -261,6 +390,10 @@ impl JavariParams {
             PresetChoice::NoThread => Some(&factory[1]),
             PresetChoice::BrightJawari => Some(&factory[2]),
             PresetChoice::Soft => Some(&factory[3]),
+            PresetChoice::BowedViolin => Some(&factory[4]),
+            PresetChoice::BowedCello => Some(&factory[5]),
+            PresetChoice::SulPonticello => Some(&factory[6]),
+            PresetChoice::Flautando => Some(&factory[7]),
         };
         let quality = match self.quality.value() {
             QualityChoice::Draft => Quality::Draft,
@@ -295,6 +428,32 @@ impl JavariParams {
             },
             output_gain_db: gain_db,
             drone: drone_from_knobs,
+            instrument: match self.instrument.value() {
+                InstrumentChoice::Tanpura => Instrument::Tanpura,
+                InstrumentChoice::Bowed => Instrument::Bowed,
+            },
+            bowed: BowedEngineSettings {
+                player: BowedPlayerSettings {
+                    tier: match self.bow_model.value() {
+                        BowModelChoice::RoundedCorner => BowTier::RoundedCorner,
+                        BowModelChoice::BowTable => BowTier::BowTable,
+                    },
+                    glide_time_s: f64::from(self.glide_ms.value()) / 1000.0,
+                    max_vibrato_cents: f64::from(self.vibrato_cents.value()),
+                    body_enabled: self.body_enabled.value(),
+                    ..BowedPlayerSettings::default()
+                },
+                string: match self.bowed_string.value() {
+                    BowedStringChoice::ViolinA => BowedStringKind::ViolinA,
+                    BowedStringChoice::CelloD => BowedStringKind::CelloD,
+                },
+                pressure: f64::from(self.bow_pressure_percent.value()) / 100.0,
+                bow_velocity_m_s: f64::from(self.bow_velocity_m_s.value()),
+                bow_position: f64::from(self.bow_position.value()),
+            },
         }
     }
 }
+
+/// Number of factory presets (`presets/*.toml`, compiled into the plugin).
+pub const FACTORY_PRESET_COUNT: usize = 8;

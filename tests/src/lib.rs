@@ -31,13 +31,22 @@ pub fn ticks_to_seconds(ticks: u32) -> f64 {
     f64::from(ticks) * f64::from(MICROSECONDS_PER_BEAT) * 1e-6 / f64::from(TICKS_PER_BEAT)
 }
 
-/// A fixture: its file name, its notes, and ticks at which CC 120 (all sound off) silences
-/// every string.
+/// A control change in a fixture: tick, controller number, value (0–127).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FixtureController {
+    pub tick: u32,
+    pub number: u8,
+    pub value: u8,
+}
+
+/// A fixture: its file name, its notes, ticks at which CC 120 (all sound off) silences every
+/// string, and other control changes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fixture {
     pub file_name: &'static str,
     pub notes: Vec<FixtureNote>,
     pub silence_ticks: Vec<u32>,
+    pub controllers: Vec<FixtureController>,
 }
 
 /// Velocity of the scale fixture's notes: 48/127 of the 2 mm default pluck, 0.76 mm, where the
@@ -51,7 +60,9 @@ pub const SCALE_VELOCITY: u8 = 48;
 ///   next one 0.1 s later) so that pitch and onset can be measured one note at a time; the
 ///   onsets fall on odd tick times that are not multiples of any block size;
 /// - `polyphony.mid`: overlapping notes at several velocities, more notes than voices, a
-///   re-plucked string and note-offs that leave strings ringing.
+///   re-plucked string and note-offs that leave strings ringing;
+/// - `bowed.mid`: a bowed phrase ([`BOWED_PHRASE`]) with a slur, a detached note and control
+///   changes for bow pressure and bow position.
 pub fn fixtures() -> Vec<Fixture> {
     let scale_keys = [45u8, 52, 57, 64, 69];
     let step = 672; // 0.7 s
@@ -70,6 +81,7 @@ pub fn fixtures() -> Vec<Fixture> {
         silence_ticks: (0..scale_keys.len() as u32)
             .map(|index| 13 + step * index + 576)
             .collect(),
+        controllers: Vec::new(),
     };
     let polyphony_notes = [
         (0u32, 48u8, 100u8),
@@ -96,9 +108,41 @@ pub fn fixtures() -> Vec<Fixture> {
             })
             .collect(),
         silence_ticks: Vec::new(),
+        controllers: Vec::new(),
     };
-    vec![scale, polyphony]
+    let bowed = Fixture {
+        file_name: "bowed.mid",
+        notes: BOWED_PHRASE
+            .iter()
+            .map(|&(start_tick, length_ticks, key)| FixtureNote {
+                start_tick,
+                length_ticks,
+                key,
+                velocity: 80,
+            })
+            .collect(),
+        silence_ticks: Vec::new(),
+        controllers: vec![
+            // More bow pressure (CC 2) during the second note, the bow nearer the fingerboard
+            // (CC 74) during the third.
+            FixtureController {
+                tick: 1400,
+                number: 2,
+                value: 75,
+            },
+            FixtureController {
+                tick: 2400,
+                number: 74,
+                value: 60,
+            },
+        ],
+    };
+    vec![scale, polyphony, bowed]
 }
+
+/// The bowed phrase (start tick, length in ticks, key; 960 ticks per second): A3, then C4 slurred
+/// to it (the notes overlap by 50 ms, so the bow glides without a new attack), then a detached E4.
+pub const BOWED_PHRASE: [(u32, u32, u8); 3] = [(96, 960, 57), (1008, 960, 60), (2112, 864, 64)];
 
 /// The standard MIDI file (format 0) of a fixture.
 pub fn fixture_bytes(fixture: &Fixture) -> Vec<u8> {
@@ -125,6 +169,19 @@ pub fn fixture_bytes(fixture: &Fixture) -> Vec<u8> {
                 message: MidiMessage::NoteOff {
                     key: u7::new(note.key),
                     vel: u7::new(0),
+                },
+            },
+        ));
+    }
+    for controller in &fixture.controllers {
+        timed.push((
+            controller.tick,
+            0,
+            TrackEventKind::Midi {
+                channel,
+                message: MidiMessage::Controller {
+                    controller: u7::new(controller.number),
+                    value: u7::new(controller.value),
                 },
             },
         ));

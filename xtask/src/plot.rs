@@ -599,7 +599,6 @@ pub fn line_plot(path: &Path, plot: &LinePlot) -> Result<(), PlotError> {
 /// mapped linearly from `value_range` onto a dark-to-bright colour ramp and clamped. The x and y
 /// ranges label the axes (e.g. seconds and hertz).
 #[allow(clippy::too_many_arguments)]
-#[allow(dead_code)] // For the render tool's spectrograms; exercised by the tests below.
 pub fn heatmap(
     path: &Path,
     values: &[f64],

@@ -10,16 +10,21 @@
 //!   --quality TIER       draft | live | studio | reference, or preset (default: the preset's
 //!                        own, else reference)
 //!   --tail-seconds S     0–60 s rendered after the last event, default 3
-//!   --plot FILE.png      spectrogram of the result (needs the plot module)
+//!   --plot FILE.png      spectrogram of the result
 //!
 //! The WAV file is mono, 32-bit float at full scale ±1. A progress bar goes to stderr.
 
 use crate::args::Args;
+use crate::plot::heatmap;
+use javari_core::analysis::power_spectrum;
+use javari_core::engine::bowed_stability::bowed_stability;
 use javari_core::engine::midi_file;
+use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::preset::{Preset, QUALITY_NAMES};
+use javari_core::engine::render::ScoreAction;
 use javari_core::engine::render::{render, rendered_length, RenderOptions, Score};
 use javari_core::engine::wav::write_wav;
-use javari_core::engine::EngineSettings;
+use javari_core::engine::{EngineEvent, EngineSettings, Instrument};
 use javari_core::quality::Quality;
 use std::io::Write;
 use std::path::PathBuf;
@@ -61,6 +66,7 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(quality) = quality {
         settings.voice.quality = quality;
     }
+    warn_if_bowed_preset_is_unstable(&settings, &score);
     let options = RenderOptions {
         sample_rate_hz,
         block_size,
@@ -98,13 +104,95 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
         (signal.len() as f64 / sample_rate_hz) / elapsed_s
     );
     if let Some(plot) = plot {
-        return Err(format!(
-            "option `--plot {}`: the spectrogram plotter is not available in this build yet",
-            plot.display()
-        )
-        .into());
+        write_spectrogram(&plot, &signal, sample_rate_hz)?;
+        eprintln!("wrote the spectrogram {}", plot.display());
     }
     Ok(())
+}
+
+/// Frame length and hop of the spectrogram, samples.
+const SPECTROGRAM_FRAME: usize = 2048;
+const SPECTROGRAM_COLUMNS: usize = 400;
+/// Frequency rows (linear, 0 Hz to the top frequency) and the dynamic range shown, dB.
+const SPECTROGRAM_ROWS: usize = 256;
+const SPECTROGRAM_RANGE_DB: f64 = 90.0;
+
+/// A spectrogram of `signal` (Hann-windowed 2048-sample frames, magnitude in dB relative to the
+/// loudest bin, up to 10 kHz or Nyquist) as a PNG heat map.
+fn write_spectrogram(
+    path: &std::path::Path,
+    signal: &[f32],
+    sample_rate_hz: f64,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let samples: Vec<f64> = signal.iter().map(|&x| f64::from(x)).collect();
+    let top_hz = (0.5 * sample_rate_hz).min(10_000.0);
+    let bin_hz = sample_rate_hz / SPECTROGRAM_FRAME as f64;
+    let hop = (samples.len().saturating_sub(SPECTROGRAM_FRAME) / SPECTROGRAM_COLUMNS).max(1);
+    let columns =
+        (samples.len().saturating_sub(SPECTROGRAM_FRAME) / hop + 1).min(SPECTROGRAM_COLUMNS);
+    let mut levels = vec![f64::MIN; SPECTROGRAM_ROWS * columns];
+    for column in 0..columns {
+        let spectrum = power_spectrum(&samples, column * hop, SPECTROGRAM_FRAME, SPECTROGRAM_FRAME);
+        for row in 0..SPECTROGRAM_ROWS {
+            let frequency = top_hz * (row as f64 + 0.5) / SPECTROGRAM_ROWS as f64;
+            let bin = ((frequency / bin_hz).round() as usize).min(spectrum.len() - 1);
+            levels[row * columns + column] = 10.0 * (spectrum[bin] + 1e-30).log10();
+        }
+    }
+    let loudest = levels.iter().cloned().fold(f64::MIN, f64::max);
+    let duration_s = samples.len() as f64 / sample_rate_hz;
+    heatmap(
+        path,
+        &levels,
+        SPECTROGRAM_ROWS,
+        columns,
+        (0.0, duration_s),
+        (0.0, top_hz),
+        (loudest - SPECTROGRAM_RANGE_DB, loudest),
+        (
+            "Spectrogram (dB re the loudest bin)",
+            "time (s)",
+            "frequency (Hz)",
+        ),
+    )?;
+    Ok(())
+}
+
+/// For a bowed preset: the stability margin of its Helmholtz motion (Woodhouse's analysis,
+/// `javari_core::stability::voice_link`) at every note the score plays, with the preset's bow
+/// controls; a warning for each note where it is unstable.
+fn warn_if_bowed_preset_is_unstable(settings: &EngineSettings, score: &Score) {
+    if settings.instrument != Instrument::Bowed {
+        return;
+    }
+    let mut notes: Vec<u8> = score
+        .events
+        .iter()
+        .filter_map(|event| match event.action {
+            ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }) if velocity > 0.0 => {
+                Some(note)
+            }
+            _ => None,
+        })
+        .collect();
+    notes.sort_unstable();
+    notes.dedup();
+    for note in notes {
+        let check = bowed_stability(&settings.bowed, note);
+        match check {
+            Ok(margin) if !margin.stable => eprintln!(
+                "warning: the bowed preset's Helmholtz motion is unstable at note {note} \
+                 ({:.1} Hz): bow force {:.3} N is above the critical {:.3} N (margin {:.2}); \
+                 expect a raucous or subharmonic sound",
+                note_to_hz(note),
+                margin.bow_force_n,
+                margin.critical_bow_force_n.unwrap_or(0.0),
+                margin.margin
+            ),
+            Ok(_) => {}
+            Err(error) => eprintln!("warning: no stability margin for note {note}: {error}"),
+        }
+    }
 }
 
 /// A one-line progress bar on stderr, redrawn when the percentage changes.

@@ -228,6 +228,28 @@ impl BowedInstrument {
         };
     }
 
+    /// Sets the bow speed target directly, m/s (clamped to 0–5); the next expression CC or
+    /// attack overrides it.
+    pub fn set_bow_velocity_m_s(&mut self, velocity_m_s: f64) {
+        if velocity_m_s.is_finite() {
+            self.velocity_target = velocity_m_s.clamp(0.0, 5.0);
+        }
+    }
+
+    /// Sets the bow position target β directly (clamped to 0.02–0.5).
+    pub fn set_bow_position(&mut self, beta: f64) {
+        if beta.is_finite() {
+            self.position_target = beta.clamp(0.02, 0.5);
+        }
+    }
+
+    /// Sets the bow pressure (0–1, see [`force_fraction_from_pressure`]).
+    pub fn set_pressure(&mut self, pressure: f64) {
+        if pressure.is_finite() {
+            self.pressure = pressure.clamp(0.0, 1.0);
+        }
+    }
+
     /// The controls the string received at the last sample.
     pub fn controls(&self) -> BowControls {
         self.controls

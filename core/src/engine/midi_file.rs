@@ -103,12 +103,27 @@ pub fn parse(bytes: &[u8], file: &str) -> Result<Score, MidiFileError> {
                 MidiMessage::NoteOff { key, .. } => ScoreAction::Engine(EngineEvent::NoteOff {
                     note: u8::from(key),
                 }),
-                MidiMessage::Controller { controller, .. } => match u8::from(controller) {
+                MidiMessage::Controller { controller, value } => match u8::from(controller) {
                     120 => ScoreAction::Engine(EngineEvent::AllSoundOff),
                     123 => ScoreAction::Engine(EngineEvent::AllNotesOff),
-                    _ => continue,
+                    number => ScoreAction::Engine(EngineEvent::Controller {
+                        number,
+                        value: f32::from(u8::from(value)) / 127.0,
+                    }),
                 },
-                _ => continue,
+                MidiMessage::ChannelAftertouch { vel } => ScoreAction::Engine(
+                    EngineEvent::ChannelPressure(f32::from(u8::from(vel)) / 127.0),
+                ),
+                MidiMessage::Aftertouch { key, vel } => {
+                    ScoreAction::Engine(EngineEvent::PolyPressure {
+                        note: u8::from(key),
+                        value: f32::from(u8::from(vel)) / 127.0,
+                    })
+                }
+                MidiMessage::PitchBend { bend } => {
+                    ScoreAction::Engine(EngineEvent::PitchBend(bend.as_f32()))
+                }
+                MidiMessage::ProgramChange { .. } => continue,
             },
             _ => continue,
         };

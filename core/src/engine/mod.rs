@@ -22,6 +22,7 @@
 //! [`Engine::set_settings`], [`Engine::set_host_tempo`] and [`Engine::reset`] never allocate,
 //! lock or panic.
 
+pub mod bowed_stability;
 pub mod drone;
 pub mod midi_file;
 pub mod pitch;
@@ -30,6 +31,7 @@ pub mod render;
 pub mod smoothing;
 pub mod wav;
 
+use crate::bowed::{BowedEvent, BowedInstrument, BowedPlayerSettings, StringConstants};
 use crate::excitation::Pluck;
 use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
 use drone::{string_ratios, DroneSequencer, DroneSettings};
@@ -51,6 +53,69 @@ pub const OUTPUT_GAIN_RANGE_DB: (f64, f64) = (-60.0, 24.0);
 /// Time constant of each voice's level follower (used to pick the quietest voice to steal), s.
 const LEVEL_RELEASE_S: f64 = 0.05;
 
+/// The bowed voice's force, in newtons at the bridge, that maps to full scale at 0 dB gain: a
+/// violin-A note at mid pressure peaks near −10 dBFS (`bowed_note_level`).
+pub const BOWED_NEWTONS_AT_FULL_SCALE: f64 = 2.0;
+
+/// Which instrument the engine plays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Instrument {
+    /// Plucked tanpura strings (polyphonic, drone mode).
+    #[default]
+    Tanpura,
+    /// One bowed string (monophonic, legato), `bowed/instrument.rs`.
+    Bowed,
+}
+
+/// The bowed string's physical constants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BowedStringKind {
+    #[default]
+    ViolinA,
+    CelloD,
+}
+
+impl BowedStringKind {
+    pub const ALL: [BowedStringKind; 2] = [BowedStringKind::ViolinA, BowedStringKind::CelloD];
+
+    pub fn constants(self) -> StringConstants {
+        match self {
+            BowedStringKind::ViolinA => StringConstants::violin_a(),
+            BowedStringKind::CelloD => StringConstants::cello_d(),
+        }
+    }
+
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// The bowed instrument's settings: the player's, the string, and the bow controls that knobs
+/// set (MIDI controllers move them too; whichever moved last wins).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BowedEngineSettings {
+    pub player: BowedPlayerSettings,
+    pub string: BowedStringKind,
+    /// Bow pressure, 0–1: the bow force as a fraction of Schelleng's range.
+    pub pressure: f64,
+    /// Bow speed, m/s (0.02–1).
+    pub bow_velocity_m_s: f64,
+    /// Bow position β (0.02–0.5).
+    pub bow_position: f64,
+}
+
+impl Default for BowedEngineSettings {
+    fn default() -> Self {
+        Self {
+            player: BowedPlayerSettings::default(),
+            string: BowedStringKind::ViolinA,
+            pressure: 0.5,
+            bow_velocity_m_s: 0.2,
+            bow_position: 0.1,
+        }
+    }
+}
+
 /// Everything the engine plays with, in SI units (normalised mappings live in the plugin).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EngineSettings {
@@ -62,6 +127,8 @@ pub struct EngineSettings {
     /// Output gain, dB (−60 to +24), applied after [`NEWTONS_AT_FULL_SCALE`].
     pub output_gain_db: f64,
     pub drone: DroneSettings,
+    pub instrument: Instrument,
+    pub bowed: BowedEngineSettings,
 }
 
 impl Default for EngineSettings {
@@ -71,6 +138,8 @@ impl Default for EngineSettings {
             pluck: Pluck::default(),
             output_gain_db: 0.0,
             drone: DroneSettings::default(),
+            instrument: Instrument::Tanpura,
+            bowed: BowedEngineSettings::default(),
         }
     }
 }
@@ -86,6 +155,14 @@ pub enum EngineEvent {
     AllNotesOff,
     /// Silences every string at once.
     AllSoundOff,
+    /// A control change, value 0–1 (the bowed instrument maps CC 1, 2, 11 and 74).
+    Controller { number: u8, value: f32 },
+    /// Channel pressure (aftertouch), 0–1.
+    ChannelPressure(f32),
+    /// Per-note pressure (polyphonic aftertouch, MPE), 0–1.
+    PolyPressure { note: u8, value: f32 },
+    /// Pitch bend, −1 to 1.
+    PitchBend(f32),
 }
 
 /// An event at a sample offset within the block passed to [`Engine::process`].
@@ -143,6 +220,10 @@ pub struct Engine {
     clock: u64,
     next_control_tick: u64,
     level_release: f32,
+    /// One bowed instrument per string kind, built up front.
+    bowed: Vec<BowedInstrument>,
+    /// The bow controls last applied from the settings (knobs), to apply only their changes.
+    applied_bow_controls: Option<(f64, f64, f64)>,
 }
 
 /// `ln(1 + k_b)`: stiffness ramps in a logarithmic domain (its range spans twelve decades) that
@@ -196,9 +277,44 @@ impl Engine {
             clock: 0,
             next_control_tick: 0,
             level_release: (-1.0 / (LEVEL_RELEASE_S * sample_rate_hz)).exp() as f32,
+            bowed: BowedStringKind::ALL
+                .iter()
+                .map(|kind| {
+                    // A rate outside the bowed capacity (8 kHz–384 kHz) falls back to the
+                    // nearest supported one; the tanpura accepts the same hosts.
+                    let rate = sample_rate_hz.clamp(8_000.0, 384_000.0);
+                    BowedInstrument::new(kind.constants(), settings.bowed.player, rate)
+                        .expect("the clamped rate is inside the bowed capacity")
+                })
+                .collect(),
+            applied_bow_controls: None,
         };
         engine.target.voice = voice;
+        engine.apply_bowed_settings();
         engine
+    }
+
+    fn bowed_mut(&mut self) -> &mut BowedInstrument {
+        let index = self.target.bowed.string.index();
+        &mut self.bowed[index]
+    }
+
+    /// Passes the bowed settings on; the knob-set bow controls only when they changed, so that
+    /// MIDI controllers keep what they set until a knob moves.
+    fn apply_bowed_settings(&mut self) {
+        let bowed = self.target.bowed;
+        for instrument in &mut self.bowed {
+            instrument.set_settings(bowed.player);
+        }
+        let controls = (bowed.pressure, bowed.bow_velocity_m_s, bowed.bow_position);
+        if self.applied_bow_controls != Some(controls) {
+            self.applied_bow_controls = Some(controls);
+            for instrument in &mut self.bowed {
+                instrument.set_pressure(bowed.pressure);
+                instrument.set_bow_velocity_m_s(bowed.bow_velocity_m_s);
+                instrument.set_bow_position(bowed.bow_position);
+            }
+        }
     }
 
     fn clamp_gain_db(db: f64) -> f64 {
@@ -242,6 +358,7 @@ impl Engine {
             .set_target(db_to_amplitude(Self::clamp_gain_db(
                 settings.output_gain_db,
             )));
+        self.apply_bowed_settings();
     }
 
     pub fn settings(&self) -> &EngineSettings {
@@ -277,6 +394,11 @@ impl Engine {
         self.drone.reset();
         self.clock = 0;
         self.next_control_tick = 0;
+        for instrument in &mut self.bowed {
+            instrument.reset();
+        }
+        self.applied_bow_controls = None;
+        self.apply_bowed_settings();
     }
 
     /// Renders `output.len()` samples (overwriting `output`) while applying `events` at their
@@ -318,6 +440,13 @@ impl Engine {
     }
 
     fn render_segment(&mut self, output: &mut [f32]) {
+        if self.target.instrument == Instrument::Bowed {
+            let scale = 1.0 / BOWED_NEWTONS_AT_FULL_SCALE;
+            let bowed = self.bowed_mut();
+            for sample in output.iter_mut() {
+                *sample += (bowed.next_sample() * scale) as f32;
+            }
+        }
         let release = self.level_release;
         for slot in &mut self.slots {
             if !slot.voice.is_active() {
@@ -365,7 +494,36 @@ impl Engine {
         }
     }
 
+    /// The bowed instrument's reading of an event (`bowed/instrument.rs` documents the mapping).
+    fn handle_bowed_event(&mut self, event: EngineEvent) {
+        let bowed_event = match event {
+            EngineEvent::NoteOn { note, velocity } => BowedEvent::NoteOn { note, velocity },
+            EngineEvent::NoteOff { note } => BowedEvent::NoteOff { note },
+            EngineEvent::AllNotesOff => BowedEvent::AllNotesOff,
+            EngineEvent::AllSoundOff => {
+                self.bowed_mut().reset();
+                return;
+            }
+            EngineEvent::Controller { number, value } => match number {
+                1 => BowedEvent::Modulation(value),
+                2 => BowedEvent::Pressure(value),
+                11 => BowedEvent::Expression(value),
+                74 => BowedEvent::Timbre(value),
+                _ => return,
+            },
+            EngineEvent::ChannelPressure(value) | EngineEvent::PolyPressure { value, .. } => {
+                BowedEvent::Pressure(value)
+            }
+            EngineEvent::PitchBend(value) => BowedEvent::PitchBend(value),
+        };
+        self.bowed_mut().handle(bowed_event);
+    }
+
     fn handle_event(&mut self, event: EngineEvent) {
+        if self.target.instrument == Instrument::Bowed {
+            self.handle_bowed_event(event);
+            return;
+        }
         match event {
             EngineEvent::NoteOn { note, velocity } if velocity > 0.0 => {
                 if self.target.drone.enabled {
@@ -386,6 +544,11 @@ impl Engine {
                     slot.level = 0.0;
                 }
             }
+            // Controllers, pressure and pitch bend do not reach a plucked string.
+            EngineEvent::Controller { .. }
+            | EngineEvent::ChannelPressure(_)
+            | EngineEvent::PolyPressure { .. }
+            | EngineEvent::PitchBend(_) => {}
         }
     }
 

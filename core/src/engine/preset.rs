@@ -24,9 +24,19 @@
 //! | `drone_first_string` | text | pa, ma, ni | first drone string |
 //! | `drone_tempo_sync` | bool | | follow the host tempo |
 //! | `drone_tempo_bpm` | 1/min | 20–300 | tempo without sync |
+//! | `instrument` | text | tanpura, bowed | which instrument plays |
+//! | `bow_model` | text | rounded-corner, bow-table | the bowed tier |
+//! | `bow_string` | text | violin-a, cello-d | the bowed string's constants |
+//! | `bow_pressure` | 1 | 0–1 | bow force as a fraction of Schelleng's range |
+//! | `bow_velocity_m_s` | m/s | 0.02–1 | bow speed |
+//! | `bow_position` | 1 | 0.02–0.5 | β, bow distance from the bridge over the string length |
+//! | `bow_glide_s` | s | 0–1 | legato glide time |
+//! | `bow_vibrato_cents` | cents | 0–100 | vibrato depth at full modulation wheel |
+//! | `bow_body` | bool | | the body resonance filter |
 
 use super::drone::TEMPO_RANGE_BPM;
-use super::{EngineSettings, OUTPUT_GAIN_RANGE_DB};
+use super::{BowedStringKind, EngineSettings, Instrument, OUTPUT_GAIN_RANGE_DB};
+use crate::bowed::BowTier;
 use crate::excitation::Pluck;
 use crate::quality::Quality;
 use crate::tanpura::{FirstString, VoiceSettings};
@@ -40,6 +50,13 @@ pub const PLUCK_POSITION_RANGE_M: (f64, f64) = (0.05, 0.6);
 
 /// Names of the quality tiers, as written in presets ([`Quality::name`]).
 pub const QUALITY_NAMES: [&str; 4] = ["draft", "live", "studio", "reference"];
+
+/// Names of the instruments, bowed models and bowed strings, as written in presets.
+pub const INSTRUMENT_NAMES: [&str; 2] = ["tanpura", "bowed"];
+pub const BOW_MODEL_NAMES: [&str; 2] = ["rounded-corner", "bow-table"];
+pub const BOW_STRING_NAMES: [&str; 2] = ["violin-a", "cello-d"];
+pub const BOW_VELOCITY_RANGE_M_S: (f64, f64) = (0.02, 1.0);
+pub const BOW_POSITION_RANGE: (f64, f64) = (0.02, 0.5);
 
 /// Names of the first drone string's choices, as written in presets.
 pub const FIRST_STRING_NAMES: [&str; 3] = ["pa", "ma", "ni"];
@@ -174,6 +191,34 @@ impl Preset {
                 "drone_tempo_bpm" => {
                     settings.drone.free_tempo_bpm = value.number(TEMPO_RANGE_BPM)?
                 }
+                "instrument" => {
+                    settings.instrument = match value.choice(&INSTRUMENT_NAMES)? {
+                        "bowed" => Instrument::Bowed,
+                        _ => Instrument::Tanpura,
+                    }
+                }
+                "bow_model" => {
+                    settings.bowed.player.tier = match value.choice(&BOW_MODEL_NAMES)? {
+                        "bow-table" => BowTier::BowTable,
+                        _ => BowTier::RoundedCorner,
+                    }
+                }
+                "bow_string" => {
+                    settings.bowed.string = match value.choice(&BOW_STRING_NAMES)? {
+                        "cello-d" => BowedStringKind::CelloD,
+                        _ => BowedStringKind::ViolinA,
+                    }
+                }
+                "bow_pressure" => settings.bowed.pressure = value.number((0.0, 1.0))?,
+                "bow_velocity_m_s" => {
+                    settings.bowed.bow_velocity_m_s = value.number(BOW_VELOCITY_RANGE_M_S)?
+                }
+                "bow_position" => settings.bowed.bow_position = value.number(BOW_POSITION_RANGE)?,
+                "bow_glide_s" => settings.bowed.player.glide_time_s = value.number((0.0, 1.0))?,
+                "bow_vibrato_cents" => {
+                    settings.bowed.player.max_vibrato_cents = value.number((0.0, 100.0))?
+                }
+                "bow_body" => settings.bowed.player.body_enabled = value.boolean()?,
                 _ => {
                     return Err(error(
                         key,
@@ -206,7 +251,16 @@ impl Preset {
              drone_enabled = {}\n\
              drone_first_string = \"{}\"\n\
              drone_tempo_sync = {}\n\
-             drone_tempo_bpm = {}\n",
+             drone_tempo_bpm = {}\n\
+             instrument = \"{}\"\n\
+             bow_model = \"{}\"\n\
+             bow_string = \"{}\"\n\
+             bow_pressure = {}\n\
+             bow_velocity_m_s = {}\n\
+             bow_position = {}\n\
+             bow_glide_s = {}\n\
+             bow_vibrato_cents = {}\n\
+             bow_body = {}\n",
             self.name,
             v.bridge_stiffness_n_m2,
             v.thread_enabled,
@@ -224,11 +278,20 @@ impl Preset {
             first_string_name(s.drone.first_string),
             s.drone.tempo_sync,
             s.drone.free_tempo_bpm,
+            INSTRUMENT_NAMES[s.instrument as usize],
+            BOW_MODEL_NAMES[s.bowed.player.tier as usize],
+            BOW_STRING_NAMES[s.bowed.string as usize],
+            s.bowed.pressure,
+            s.bowed.bow_velocity_m_s,
+            s.bowed.bow_position,
+            s.bowed.player.glide_time_s,
+            s.bowed.player.max_vibrato_cents,
+            s.bowed.player.body_enabled,
         )
     }
 }
 
-const KNOWN_KEYS: [&str; 17] = [
+const KNOWN_KEYS: [&str; 26] = [
     "name",
     "bridge_stiffness_n_m2",
     "thread_enabled",
@@ -246,6 +309,15 @@ const KNOWN_KEYS: [&str; 17] = [
     "drone_first_string",
     "drone_tempo_sync",
     "drone_tempo_bpm",
+    "instrument",
+    "bow_model",
+    "bow_string",
+    "bow_pressure",
+    "bow_velocity_m_s",
+    "bow_position",
+    "bow_glide_s",
+    "bow_vibrato_cents",
+    "bow_body",
 ];
 
 /// Removes a `#` comment that is not inside a quoted string.
@@ -323,6 +395,10 @@ mod tests {
         preset.settings.drone.enabled = true;
         preset.settings.drone.first_string = FirstString::Ni;
         preset.settings.voice.quality = Quality::Studio;
+        preset.settings.instrument = Instrument::Bowed;
+        preset.settings.bowed.string = BowedStringKind::CelloD;
+        preset.settings.bowed.player.tier = BowTier::BowTable;
+        preset.settings.bowed.bow_position = 0.07;
         let parsed = Preset::parse(&preset.to_text(), "mem").unwrap();
         assert_eq!(parsed, preset);
     }
