@@ -8,7 +8,9 @@
 //!   eigenvalues (by decreasing modulus) at `--zeta`, or at the threshold when it is absent;
 //! - a sweep: `--sweep fig7|fig8|fig13|fig10 [--csv FILE] [--png FILE]` recomputes the paper's
 //!   threshold curves;
-//! - a preset: `--preset FILE [--json]` prints the stability margin of a bowed setting.
+//! - a preset: `--preset FILE [--json]` prints the stability margin of a bowed setting, either an
+//!   analysis-grid setting (keys below) or one of the instrument's bowed presets
+//!   (`presets/bowed-*.toml`, checked across the string's range).
 //!
 //! `--slip N` counts slipping steps per period in the chosen formulation's own time step. The
 //! space-time step is one segment's travel: a period has 2(p + q) steps and the Helmholtz motion
@@ -19,6 +21,9 @@
 
 use crate::args::{ArgError, Args};
 use crate::plot::{self, AxisScale, LinePlot, Series, SeriesStyle, PALETTE};
+use javari_core::engine::bowed_stability::bowed_stability;
+use javari_core::engine::preset::Preset as EnginePreset;
+use javari_core::engine::{BowedStringKind, Instrument};
 use javari_core::stability::{
     stability_margin, BowedSetting, CompactModel, ContactPattern, Eigenvalue, PeriodicMotion,
     ReflectionFunction, SpaceTimeModel, StabilityMargin, ThresholdOutcome, ThresholdSearch,
@@ -26,7 +31,7 @@ use javari_core::stability::{
 };
 use std::error::Error;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 const USAGE: &str = "usage:
   cargo xtask stability --p P --q Q --lambda L --gamma G [--sigma S] [--slip N] [--zeta Z]
@@ -185,6 +190,9 @@ fn execute(command: &Command) -> Result<String, Box<dyn Error>> {
         Command::Preset { path, json } => {
             let text = std::fs::read_to_string(path)
                 .map_err(|error| format!("preset `{}`: {error}", path.display()))?;
+            if is_engine_preset(&text) {
+                return engine_preset_report(&text, path, *json);
+            }
             let setting = parse_preset(&text)
                 .map_err(|error| format!("preset `{}`: {error}", path.display()))?;
             let margin = stability_margin(&setting)?;
@@ -195,6 +203,71 @@ fn execute(command: &Command) -> Result<String, Box<dyn Error>> {
             })
         }
     }
+}
+
+/// Whether a preset file is one of the instrument's (`presets/*.toml`, with an `instrument`
+/// key) rather than an analysis-grid setting.
+fn is_engine_preset(text: &str) -> bool {
+    text.lines()
+        .any(|line| line.trim_start().starts_with("instrument"))
+}
+
+/// Notes at which a bowed instrument preset is checked: the string's playable range in steps
+/// of a fifth (violin A: G3 to E6; cello D: C2 to C5).
+fn preset_notes(string: BowedStringKind) -> Vec<u8> {
+    let (low, high) = match string {
+        BowedStringKind::ViolinA => (55u8, 88u8),
+        BowedStringKind::CelloD => (36, 72),
+    };
+    (low..=high).step_by(7).collect()
+}
+
+/// The margin of an instrument preset's bow (its pressure, speed and position) across the
+/// string's range, one line per note, or a JSON array.
+fn engine_preset_report(text: &str, path: &Path, json: bool) -> Result<String, Box<dyn Error>> {
+    let file = path.display().to_string();
+    let preset = EnginePreset::parse(text, &file)?;
+    if preset.settings.instrument != Instrument::Bowed {
+        return Err(format!(
+            "preset `{file}`: `instrument` is \"tanpura\"; the stability analysis is for bowed presets"
+        )
+        .into());
+    }
+    let mut lines = Vec::new();
+    for note in preset_notes(preset.settings.bowed.string) {
+        let verdict = bowed_stability(&preset.settings.bowed, note)?;
+        lines.push(if json {
+            format!(
+                "{{\"note\": {note}, \"bow_force_n\": {:.6}, \"critical_bow_force_n\": {}, \"margin\": {:.6}, \"stable\": {}}}",
+                verdict.bow_force_n,
+                verdict
+                    .critical_bow_force_n
+                    .map_or("null".to_string(), |force| format!("{force:.6}")),
+                verdict.margin,
+                verdict.stable
+            )
+        } else {
+            format!(
+                "note {note:3}: bow force {:.3} N, critical {}, margin {:.2}: {}",
+                verdict.bow_force_n,
+                verdict
+                    .critical_bow_force_n
+                    .map_or("none".to_string(), |force| format!("{force:.3} N")),
+                verdict.margin,
+                if verdict.stable { "STABLE" } else { "UNSTABLE" }
+            )
+        });
+    }
+    Ok(if json {
+        format!("[{}]\n", lines.join(", "))
+    } else {
+        format!(
+            "preset `{}` ({}):\n{}\n",
+            preset.name,
+            file,
+            lines.join("\n")
+        )
+    })
 }
 
 /// The analysis of one case: threshold and spectrum.
@@ -813,6 +886,22 @@ mod tests {
         // Sorted by decreasing modulus: the first listed is 0.9964 (Table I).
         let first = output.split("\"eigenvalues\": [{\"abs\": ").nth(1).unwrap();
         assert!(first.starts_with("0.9964"), "{first}");
+    }
+
+    #[test]
+    fn instrument_presets_are_checked_across_the_string() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let violin = root.join("presets/bowed-violin.toml");
+        let text = std::fs::read_to_string(&violin).unwrap();
+        let report = engine_preset_report(&text, &violin, false).unwrap();
+        assert_eq!(
+            report.lines().count(),
+            1 + preset_notes(BowedStringKind::ViolinA).len()
+        );
+        assert!(report.contains("STABLE"), "{report}");
+        let tanpura = root.join("presets/classic.toml");
+        let text = std::fs::read_to_string(&tanpura).unwrap();
+        assert!(engine_preset_report(&text, &tanpura, false).is_err());
     }
 
     #[test]
