@@ -22,6 +22,7 @@ pub mod engine;
 pub mod excitation;
 pub mod newton;
 pub mod quality;
+pub mod snapshot;
 pub mod string_operator;
 pub mod tanpura;
 pub mod tanpura_string;

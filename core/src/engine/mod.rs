@@ -317,6 +317,41 @@ impl Engine {
         }
     }
 
+    /// Fills `snapshot` with the state of the loudest ringing string (when none rings, the one
+    /// plucked last, at rest), the Newton statistics of all strings, and the factor that turns
+    /// this engine's output back into pickup force. For the editor's live view
+    /// (`crate::snapshot`); allocation-free, never panics.
+    pub fn fill_snapshot(&self, snapshot: &mut crate::snapshot::TanpuraSnapshot) {
+        let Some(shown) = self.slots.iter().max_by(|a, b| {
+            a.voice
+                .is_active()
+                .cmp(&b.voice.is_active())
+                .then(a.level.total_cmp(&b.level))
+                .then(a.plucked_at.cmp(&b.plucked_at))
+        }) else {
+            return;
+        };
+        let string = shown.voice.string();
+        snapshot.fill_string(string);
+        snapshot.active_voices = self.active_voices();
+        snapshot.fundamental_hz = shown.fundamental_hz;
+        snapshot.sample_rate_hz = self.sample_rate_hz;
+        snapshot.oversample =
+            (1.0 / (string.config().time_step_s * self.sample_rate_hz)).round() as u32;
+        let mut newton = crate::newton::NewtonStats::default();
+        for slot in &self.slots {
+            newton.merge(slot.voice.newton_stats());
+        }
+        snapshot.newton = newton;
+        // Output = force · level_factor / NEWTONS_AT_FULL_SCALE · gain (`render_segment`).
+        let gain = self.output_gain.value();
+        snapshot.output_to_force_n = if gain > 0.0 && shown.level_factor > 0.0 {
+            NEWTONS_AT_FULL_SCALE / (shown.level_factor * gain)
+        } else {
+            0.0
+        };
+    }
+
     fn clamp_gain_db(db: f64) -> f64 {
         if db.is_nan() {
             0.0

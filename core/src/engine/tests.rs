@@ -191,3 +191,37 @@ fn reset_renders_exactly_as_a_new_engine() {
     let second = run(&mut engine, &[note_on(3, 62)], 1_000);
     assert_eq!(first, second);
 }
+
+/// The editor's snapshot (`crate::snapshot`) shows the loudest ringing string exactly as the
+/// engine holds it, and the Newton statistics of all strings.
+#[test]
+fn snapshot_equals_the_loudest_string_exactly() {
+    let mut engine = Engine::new(&EngineSettings::default(), RATE, 4);
+    let quiet = TimedEvent {
+        offset: 0,
+        event: EngineEvent::NoteOn {
+            note: 48,
+            velocity: 0.1,
+        },
+    };
+    run(&mut engine, &[quiet, note_on(10, 55)], 300);
+    let mut snapshot = crate::snapshot::TanpuraSnapshot::default();
+    for _ in 0..4 {
+        run(&mut engine, &[], 97);
+        engine.fill_snapshot(&mut snapshot);
+        let loudest = engine
+            .slots
+            .iter()
+            .max_by(|a, b| a.level.total_cmp(&b.level))
+            .unwrap();
+        assert_eq!(snapshot.fundamental_hz, pitch::note_to_hz(55));
+        assert_eq!(loudest.fundamental_hz, snapshot.fundamental_hz);
+        crate::snapshot::tests::assert_snapshot_is_string(&snapshot, loudest.voice.string());
+        let mut all = crate::newton::NewtonStats::default();
+        for slot in &engine.slots {
+            all.merge(slot.voice.newton_stats());
+        }
+        assert_eq!(snapshot.newton, all);
+        assert_eq!(snapshot.active_voices, 2);
+    }
+}
