@@ -14,8 +14,10 @@
 //! (`javari_core::bowed::instrument` documents that mapping): CCs, channel and per-note pressure
 //! and pitch bend reach it too.
 
+pub mod editor;
 pub mod params;
 
+use editor::channel::{SnapshotChannel, SnapshotPublisher, QUEUE_FRAMES};
 use javari_core::engine::preset::Preset;
 use javari_core::engine::render::DEFAULT_VOICE_COUNT;
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
@@ -24,6 +26,7 @@ use nice_plug::prelude::*;
 use params::JavariParams;
 use std::num::NonZeroU32;
 use std::sync::Arc;
+use std::time::Instant;
 
 /// The factory presets, compiled in from `presets/` (the files `render --preset` reads).
 pub const FACTORY_PRESET_FILES: [(&str, &str); params::FACTORY_PRESET_COUNT] = [
@@ -78,6 +81,9 @@ pub struct Javari {
     engine: Option<Engine>,
     events: Vec<TimedEvent>,
     mono: Vec<f32>,
+    /// The audio thread's end of the editor channel (measures load, publishes snapshots).
+    snapshots: SnapshotPublisher,
+    editor_state: Arc<editor::EguiEditorState>,
 }
 
 impl Default for Javari {
@@ -88,6 +94,8 @@ impl Default for Javari {
             engine: None,
             events: Vec::with_capacity(EVENT_CAPACITY),
             mono: Vec::new(),
+            snapshots: SnapshotPublisher::new(SnapshotChannel::new(QUEUE_FRAMES)),
+            editor_state: editor::default_state(),
         }
     }
 }
@@ -108,12 +116,20 @@ impl Plugin for Javari {
     const SAMPLE_ACCURATE_AUTOMATION: bool = false;
     const INPUT_EVENT_CAPACITY: usize = EVENT_CAPACITY;
 
-    type Editor = ();
+    type Editor = editor::JavariEditor;
     type SysExMessage = ();
     type BackgroundTask = ();
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()
+    }
+
+    fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
+        editor::create(
+            self.params.clone(),
+            self.snapshots.channel().clone(),
+            self.editor_state.clone(),
+        )
     }
 
     fn activate(
@@ -131,6 +147,7 @@ impl Plugin for Javari {
         if rebuild {
             self.engine = Some(Engine::new(&settings, rate, DEFAULT_VOICE_COUNT));
         }
+        self.snapshots.prepare(rate);
         self.mono
             .resize(buffer_config.max_buffer_size.max(1) as usize, 0.0);
         true
@@ -150,6 +167,7 @@ impl Plugin for Javari {
         _aux: &mut AuxiliaryBuffers,
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
+        let started = Instant::now();
         let Some(engine) = &mut self.engine else {
             return ProcessStatus::Error("process called before activate");
         };
@@ -157,6 +175,15 @@ impl Plugin for Javari {
         engine.set_host_tempo(context.transport().tempo);
 
         self.events.clear();
+        if let Some(note) = self.snapshots.channel().take_audition() {
+            self.events.push(TimedEvent {
+                offset: 0,
+                event: EngineEvent::NoteOn {
+                    note,
+                    velocity: 1.0,
+                },
+            });
+        }
         while let Some(event) = context.next_event() {
             let offset = event.timing() as usize;
             let engine_event = match event {
@@ -217,11 +244,13 @@ impl Plugin for Javari {
             }
             let mono = &mut self.mono[..end - start];
             engine.process(&self.events[first_event..next_event], mono);
+            self.snapshots.record_output(mono);
             for channel in channels.iter_mut() {
                 channel[start..end].copy_from_slice(mono);
             }
             start = end;
         }
+        self.snapshots.end_block(engine, samples, started.elapsed());
         ProcessStatus::KeepAlive
     }
 }

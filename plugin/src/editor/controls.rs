@@ -1,0 +1,271 @@
+//! The parameter panel and the top bar (presets, audition, quality indicator).
+//!
+//! Every parameter is a nice-plug-egui `ParamSlider`: drag to change (shift for fine steps),
+//! double-click or ctrl-click to reset to the default, click the value to type one. The units
+//! come from the parameters themselves (`params.rs`); the tooltips say what each does to the
+//! physical string.
+
+use super::channel::SnapshotChannel;
+use crate::params::{JavariParams, PresetChoice};
+use crate::FACTORY_PRESET_FILES;
+use egui::{self, Color32, RichText};
+use javari_core::engine::pitch::note_to_hz;
+use javari_core::snapshot::TanpuraSnapshot;
+use nice_plug::prelude::{Enum, Param, ParamSetter};
+use nice_plug_egui::widgets::ParamSlider;
+
+const SLIDER_WIDTH: f32 = 150.0;
+/// Real-time load above which the indicator turns amber, then red.
+const LOAD_WARNING: f32 = 0.5;
+const LOAD_OVERRUN: f32 = 0.9;
+
+/// One labelled parameter row with its physical tooltip.
+fn row<P: Param>(
+    ui: &mut egui::Ui,
+    setter: &ParamSetter,
+    param: &P,
+    tooltip: &str,
+) -> egui::Response {
+    ui.horizontal(|ui| {
+        ui.add_sized([120.0, 18.0], egui::Label::new(param.name()).truncate())
+            .on_hover_text(tooltip);
+        ui.add(ParamSlider::for_param(param, setter).with_width(SLIDER_WIDTH))
+            .on_hover_text(tooltip)
+    })
+    .inner
+}
+
+fn group(ui: &mut egui::Ui, title: &str, contents: impl FnOnce(&mut egui::Ui)) {
+    egui::Frame::group(ui.style()).show(ui, |ui| {
+        ui.set_width(ui.available_width());
+        ui.label(
+            RichText::new(title)
+                .strong()
+                .color(Color32::from_rgb(230, 190, 120)),
+        );
+        contents(ui);
+    });
+    ui.add_space(4.0);
+}
+
+/// The parameter groups: strings and tuning, jawari, pluck, damping, bowing, quality, output.
+pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &ParamSetter) {
+    egui::ScrollArea::vertical().show(ui, |ui| {
+        group(ui, "Strings and tuning", |ui| {
+            ui.label(
+                RichText::new("Each MIDI note plucks a string tuned to it (12-TET, A4 = 440 Hz).")
+                    .small(),
+            );
+            row(ui, setter, &params.drone_enabled,
+                "Drone mode: a held MIDI note sets Sa, and four strings (first string, Sa, Sa, low Sa) are plucked in the classic cycle.");
+            row(ui, setter, &params.drone_first_string,
+                "Tuning of the first drone string: Pa = 3/4 of Sa (the fifth below), Ma = 2/3 (the fourth below), Ni = 15/16 (the major seventh below).");
+            row(ui, setter, &params.drone_tempo_sync,
+                "On: the drone cycle follows the host's tempo. Off: it uses the drone tempo below.");
+            row(ui, setter, &params.drone_tempo_bpm,
+                "Tempo of the drone cycle when not synced to the host, plucks per minute.");
+        });
+        group(ui, "Jawari: thread and bridge", |ui| {
+            row(ui, setter, &params.thread_enabled,
+                "The cotton thread between string and curved bridge. It lifts the string just above the bridge crest, so the string grazes the crest on every swing: that grazing contact is the jawari buzz.");
+            row(ui, setter, &params.thread_position_mm,
+                "Where the thread sits, measured from the tuning bead (the bridge crest is at 46.5 mm). It sets where the speaking length starts and how much of the curved bridge the string wraps over, which moves the buzz's formant.");
+            row(ui, setter, &params.bridge_stiffness_log10,
+                "Contact stiffness k_b of bridge and thread (Hunt–Crossley law, force per metre of contact per metre of penetration). Harder gives a sharper collision and a brighter buzz; the seed uses 1e8 N/m².");
+            row(ui, setter, &params.bridge_beyond_thread,
+                "Off removes bridge contact past the thread (k_b = 0 for x > x_c): the string can no longer graze the crest, the modes decay independently and the jawari formant disappears (the seed's comparison).");
+        });
+        group(ui, "Pluck", |ui| {
+            row(ui, setter, &params.pluck_position_mm,
+                "Where the finger presses the string, from the tuning bead (the nut is at 668 mm). Closer to the bridge excites more high partials.");
+            row(ui, setter, &params.pluck_width_mm,
+                "Width of the fingertip that lifts the string. A wider, softer finger excites fewer high partials.");
+            row(ui, setter, &params.pluck_amplitude_mm,
+                "How far the finger lifts the string before letting go, at full MIDI velocity (velocity scales it). A larger swing presses harder into the bridge.");
+        });
+        group(ui, "Damping", |ui| {
+            row(ui, setter, &params.gamma_per_s,
+                "Frequency-independent loss γ (air and internal friction): every mode decays at about γ/2 per second. Lower rings longer.");
+            row(ui, setter, &params.eta_ns,
+                "Frequency-dependent loss η (Kelvin–Voigt on tension and stiffness): decay grows as η ω²/2, so high partials die first. Higher sounds darker.");
+        });
+        group(ui, "Bowing", |ui| {
+            ui.label(
+                RichText::new(
+                    "The bowed voice has no plugin parameters yet: the plugin plays the tanpura.",
+                )
+                .small()
+                .italics(),
+            );
+        });
+        group(ui, "Quality", |ui| {
+            row(ui, setter, &params.quality,
+                "How finely the string is simulated: internal oversampling, grid and Newton settings. Higher tiers are more accurate and cost more CPU (watch the load meter above).");
+        });
+        group(ui, "Output", |ui| {
+            row(ui, setter, &params.nut_pickup_percent,
+                "What you hear: 100 % is the force the string exerts on the nut (eq. 13), 0 % the force on bridge and thread (eq. 12), in between a mix.");
+            row(ui, setter, &params.output_gain_db,
+                "Output level. At 0 dB a pickup force of 2 N is digital full scale.");
+        });
+        ui.label(
+            RichText::new("Double-click a slider to reset it; click its value to type one.")
+                .small()
+                .weak(),
+        );
+    });
+}
+
+/// Preset browser, audition button and the quality indicator.
+pub fn top_bar(
+    ui: &mut egui::Ui,
+    params: &JavariParams,
+    setter: &ParamSetter,
+    snapshot: &TanpuraSnapshot,
+    channel: &SnapshotChannel,
+    audition_note: &mut u8,
+) {
+    ui.horizontal(|ui| {
+        ui.label(RichText::new("Javari").heading().strong());
+        ui.separator();
+        preset_browser(ui, params, setter);
+        ui.separator();
+        let name = note_name(*audition_note);
+        ui.add(
+            egui::DragValue::new(audition_note)
+                .range(24..=96)
+                .custom_formatter(|value, _| note_name(value as u8)),
+        )
+        .on_hover_text("The note the Pluck button plays (drag to change).");
+        if ui
+            .button("Pluck")
+            .on_hover_text(format!(
+                "Plucks the string tuned to {name} ({:.1} Hz) with the pluck settings, as a MIDI note would.",
+                note_to_hz(*audition_note)
+            ))
+            .clicked()
+        {
+            channel.request_audition(*audition_note);
+        }
+        ui.separator();
+        quality_indicator(ui, params, snapshot, channel);
+    });
+}
+
+fn preset_browser(ui: &mut egui::Ui, params: &JavariParams, setter: &ParamSetter) {
+    let names = PresetChoice::variants();
+    let current = params.preset.value().to_index();
+    let choose = |index: usize| {
+        setter.begin_set_parameter(&params.preset);
+        setter.set_parameter(&params.preset, PresetChoice::from_index(index));
+        setter.end_set_parameter(&params.preset);
+    };
+    ui.label("Preset");
+    if ui
+        .small_button("◀")
+        .on_hover_text("Previous preset")
+        .clicked()
+    {
+        choose((current + names.len() - 1) % names.len());
+    }
+    egui::ComboBox::from_id_salt("javari-preset")
+        .selected_text(names[current])
+        .width(130.0)
+        .show_ui(ui, |ui| {
+            for (index, name) in names.iter().enumerate() {
+                let hover = match index.checked_sub(1).and_then(|i| FACTORY_PRESET_FILES.get(i)) {
+                    Some((file, _)) => format!("Factory preset from {file}"),
+                    None => "Custom: the sliders on the left play".to_string(),
+                };
+                if ui
+                    .selectable_label(index == current, *name)
+                    .on_hover_text(hover)
+                    .clicked()
+                {
+                    choose(index);
+                }
+            }
+        })
+        .response
+        .on_hover_text(
+            "Factory presets (presets/*.toml). Anything but Custom overrides the sound parameters; gain and drone stay yours.",
+        );
+    if ui.small_button("▶").on_hover_text("Next preset").clicked() {
+        choose((current + 1) % names.len());
+    }
+}
+
+fn quality_indicator(
+    ui: &mut egui::Ui,
+    params: &JavariParams,
+    snapshot: &TanpuraSnapshot,
+    channel: &SnapshotChannel,
+) {
+    let load = snapshot.realtime_load;
+    let load_colour = if load >= LOAD_OVERRUN {
+        Color32::from_rgb(240, 80, 70)
+    } else if load >= LOAD_WARNING {
+        Color32::from_rgb(240, 180, 60)
+    } else {
+        Color32::from_rgb(110, 210, 120)
+    };
+    ui.label(format!("Quality: {}", params.quality))
+        .on_hover_text(format!(
+            "The string runs at {}× the output rate on a grid of N = {} intervals; Newton stops at {:.0e} m or after {} updates per step.",
+            snapshot.oversample, snapshot.grid_intervals, snapshot.newton_tolerance_m, snapshot.newton_cap
+        ));
+    ui.label(RichText::new(format!("load {:.0} %", 100.0 * load)).color(load_colour))
+        .on_hover_text(
+            "Real-time load measured on the audio thread: the time process() took over the block's duration (largest in the last 20 ms). Above 100 % the audio drops out.",
+        );
+    let caps = snapshot.cap_hits_since_last_frame;
+    let cap_colour = if caps > 0 {
+        Color32::from_rgb(240, 80, 70)
+    } else {
+        ui.visuals().text_color()
+    };
+    ui.label(
+        RichText::new(format!(
+            "Newton {:.2} it/step, cap hits {} ({} total)",
+            snapshot.mean_iterations_since_last_frame, caps, snapshot.newton.cap_hits
+        ))
+        .color(cap_colour),
+    )
+    .on_hover_text(
+        "Newton updates per time step in the last 20 ms, and steps that hit the iteration cap without converging (they continue with the last iterate).",
+    );
+    ui.label(
+        RichText::new(format!(
+            "frames {} / dropped {}",
+            channel.published(),
+            channel.dropped()
+        ))
+        .small()
+        .weak(),
+    )
+    .on_hover_text(
+        "Snapshots the audio thread published, and those it dropped rather than wait for a busy editor.",
+    );
+}
+
+/// "D3"-style name of a MIDI note (60 = C4).
+pub fn note_name(note: u8) -> String {
+    const NAMES: [&str; 12] = [
+        "C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B",
+    ];
+    let octave = i32::from(note) / 12 - 1;
+    format!("{}{}", NAMES[usize::from(note) % 12], octave)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::note_name;
+
+    #[test]
+    fn note_names_follow_c4_is_60() {
+        assert_eq!(note_name(60), "C4");
+        assert_eq!(note_name(69), "A4");
+        assert_eq!(note_name(50), "D3");
+        assert_eq!(note_name(24), "C1");
+    }
+}
