@@ -259,9 +259,16 @@ impl SnapshotReceiver {
 
     /// Pops every waiting frame; returns true if a new one arrived.
     pub fn poll(&mut self) -> bool {
+        self.poll_each(|_| ())
+    }
+
+    /// Pops every waiting frame, oldest first, showing each to `visit`; the newest is kept.
+    /// Returns true if a new one arrived.
+    pub fn poll_each(&mut self, mut visit: impl FnMut(&TanpuraSnapshot)) -> bool {
         let mut fresh = false;
         while let Some(snapshot) = self.channel.queue.pop() {
             *self.latest = snapshot;
+            visit(&self.latest);
             self.received += 1;
             fresh = true;
         }

@@ -14,7 +14,7 @@ use javari_core::snapshot::TanpuraSnapshot;
 use nice_plug::prelude::{Enum, Param, ParamSetter};
 use nice_plug_egui::widgets::ParamSlider;
 
-const SLIDER_WIDTH: f32 = 150.0;
+const SLIDER_WIDTH: f32 = 130.0;
 /// Real-time load above which the indicator turns amber, then red.
 const LOAD_WARNING: f32 = 0.5;
 const LOAD_OVERRUN: f32 = 0.9;
@@ -27,7 +27,7 @@ fn row<P: Param>(
     tooltip: &str,
 ) -> egui::Response {
     ui.horizontal(|ui| {
-        ui.add_sized([120.0, 18.0], egui::Label::new(param.name()).truncate())
+        ui.add_sized([112.0, 18.0], egui::Label::new(param.name()).truncate())
             .on_hover_text(tooltip);
         ui.add(ParamSlider::for_param(param, setter).with_width(SLIDER_WIDTH))
             .on_hover_text(tooltip)
@@ -162,7 +162,7 @@ fn preset_browser(ui: &mut egui::Ui, params: &JavariParams, setter: &ParamSetter
     };
     ui.label("Preset");
     if ui
-        .small_button("◀")
+        .small_button("<")
         .on_hover_text("Previous preset")
         .clicked()
     {
@@ -188,9 +188,9 @@ fn preset_browser(ui: &mut egui::Ui, params: &JavariParams, setter: &ParamSetter
         })
         .response
         .on_hover_text(
-            "Factory presets (presets/*.toml). Anything but Custom overrides the sound parameters; gain and drone stay yours.",
+            "Factory presets (presets/*.toml); < and > step through them. Anything but Custom overrides the sound parameters; gain and drone stay yours.",
         );
-    if ui.small_button("▶").on_hover_text("Next preset").clicked() {
+    if ui.small_button(">").on_hover_text("Next preset").clicked() {
         choose((current + 1) % names.len());
     }
 }

@@ -80,9 +80,10 @@ impl NiceEguiApp for EditorApp {
     }
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut Frame) {
-        if self.receiver.poll() {
-            self.analysis.update(self.receiver.latest());
-        }
+        // Every frame that arrived goes into the spectrogram, so its time axis stays 20 ms per
+        // column even when the window repaints less often.
+        let analysis = &mut self.analysis;
+        self.receiver.poll_each(|frame| analysis.update(frame));
         ui.ctx().request_repaint_after(REPAINT_INTERVAL);
         let Some(gui) = self.gui.clone() else {
             return;
@@ -102,7 +103,7 @@ impl NiceEguiApp for EditorApp {
         });
         egui::Panel::left("javari-parameters")
             .resizable(false)
-            .exact_size(330.0)
+            .exact_size(372.0)
             .show(ui, |ui| {
                 controls::parameter_groups(ui, &self.params, &setter);
             });

@@ -6,7 +6,7 @@
 use super::spectrum::{ForceAnalysis, DYNAMIC_RANGE_DB, MAX_SHOWN_HZ, SPECTROGRAM_ROWS};
 use crate::params::JavariParams;
 use egui::{self, pos2, vec2, Align2, Color32, FontId, Painter, Pos2, Rect, Sense, Shape, Stroke};
-use javari_core::snapshot::TanpuraSnapshot;
+use javari_core::snapshot::{BarrierView, TanpuraSnapshot, MAX_BRIDGE_POINTS};
 
 const STRING_COLOUR: Color32 = Color32::from_rgb(240, 220, 140);
 const REST_COLOUR: Color32 = Color32::from_rgb(110, 110, 120);
@@ -115,7 +115,7 @@ pub fn live_view(
 }
 
 fn inner(rect: Rect) -> Rect {
-    Rect::from_min_max(rect.min + vec2(44.0, 20.0), rect.max - vec2(8.0, 16.0))
+    Rect::from_min_max(rect.min + vec2(60.0, 20.0), rect.max - vec2(8.0, 16.0))
 }
 
 fn whole_string(painter: &Painter, rect: Rect, snapshot: &TanpuraSnapshot, pluck_m: f64) {
@@ -240,30 +240,27 @@ fn close_up(painter: &Painter, rect: Rect, snapshot: &TanpuraSnapshot) {
     let clip = painter.with_clip_rect(plot);
     let bottom = axes.y.0;
 
-    // Bridge: a filled body under its surface points.
+    // Bridge: the body under its surface points.
     let bridge = &snapshot.bridge;
     if bridge.len > 1 {
-        let mut body: Vec<Pos2> = (0..bridge.len)
-            .map(|i| {
-                axes.point(
-                    f64::from(bridge.positions_m[i]),
-                    f64::from(bridge.heights_m[i]).max(bottom),
-                )
-            })
-            .collect();
-        body.push(axes.point(f64::from(bridge.positions_m[bridge.len - 1]), bottom));
-        body.push(axes.point(f64::from(bridge.positions_m[0]), bottom));
-        for window in 1..bridge.len {
-            let a = body[window - 1];
-            let b = body[window];
-            let base_a = pos2(a.x, plot.bottom());
-            let base_b = pos2(b.x, plot.bottom());
-            clip.add(Shape::convex_polygon(
-                vec![a, b, base_b, base_a],
+        // One vertical strip per pair of neighbouring points, as a plain mesh (no
+        // anti-aliasing seams between strips).
+        let mut body = egui::Mesh::default();
+        for i in 0..bridge.len {
+            let x = f64::from(bridge.positions_m[i]);
+            body.colored_vertex(
+                axes.point(x, f64::from(bridge.heights_m[i]).max(bottom)),
                 BRIDGE_COLOUR,
-                Stroke::NONE,
-            ));
+            );
+            body.colored_vertex(axes.point(x, bottom), BRIDGE_COLOUR);
         }
+        for i in 1..bridge.len as u32 {
+            let (top_left, base_left, top_right, base_right) =
+                (2 * i - 2, 2 * i - 1, 2 * i, 2 * i + 1);
+            body.add_triangle(top_left, base_left, top_right);
+            body.add_triangle(top_right, base_left, base_right);
+        }
+        clip.add(Shape::mesh(body));
     } else {
         label(
             painter,
@@ -272,10 +269,17 @@ fn close_up(painter: &Painter, rect: Rect, snapshot: &TanpuraSnapshot) {
             "no bridge contact (k_b = 0)",
         );
     }
-    // Thread: its cap above the bridge surface.
+    // Thread: its cap, drawn where it stands above the bridge surface (elsewhere it is
+    // inside the bridge body and the string cannot reach it).
     let thread = &snapshot.thread;
     if thread.len > 1 {
+        let above_bridge = |i: usize| {
+            let x = thread.positions_m[i];
+            let surface = bridge_height_at(bridge, x).unwrap_or(f32::NEG_INFINITY);
+            thread.heights_m[i] >= surface
+        };
         let top: Vec<Pos2> = (0..thread.len)
+            .filter(|&i| above_bridge(i))
             .map(|i| {
                 axes.point(
                     f64::from(thread.positions_m[i]),
@@ -283,10 +287,16 @@ fn close_up(painter: &Painter, rect: Rect, snapshot: &TanpuraSnapshot) {
                 )
             })
             .collect();
-        clip.line(top.clone(), Stroke::new(3.0, THREAD_COLOUR));
+        let crown = (0..thread.len)
+            .max_by(|&a, &b| thread.heights_m[a].total_cmp(&thread.heights_m[b]))
+            .unwrap_or(0);
+        clip.line(top, Stroke::new(3.0, THREAD_COLOUR));
         label(
             painter,
-            axes.point(f64::from(thread.positions_m[thread.len / 2]), axes.y.1) + vec2(0.0, 14.0),
+            axes.point(
+                f64::from(thread.positions_m[crown]),
+                f64::from(thread.heights_m[crown]),
+            ) + vec2(0.0, 18.0),
             Align2::CENTER_TOP,
             "thread",
         );
@@ -432,7 +442,7 @@ fn force_strip(painter: &Painter, rect: Rect, snapshot: &TanpuraSnapshot) {
 }
 
 fn spectrum(painter: &Painter, rect: Rect, analysis: &ForceAnalysis) {
-    frame(painter, rect, "Spectrum of the force (Hann, 2048)");
+    frame(painter, rect, "Spectrum (Hann, 2048 samples)");
     if analysis.bin_hz <= 0.0 {
         return;
     }
@@ -492,11 +502,7 @@ fn spectrum(painter: &Painter, rect: Rect, analysis: &ForceAnalysis) {
 }
 
 fn spectrogram(ui: &egui::Ui, painter: &Painter, rect: Rect, analysis: &mut ForceAnalysis) {
-    frame(
-        painter,
-        rect,
-        "Spectrogram, last 6 s, 0–8 kHz (red: formant centroid)",
-    );
+    frame(painter, rect, "Spectrogram, 6 s, 0–8 kHz (red: centroid)");
     let frames = analysis.spectrogram_db.len();
     if frames == 0 {
         return;
@@ -574,6 +580,18 @@ fn spectrogram(ui: &egui::Ui, painter: &Painter, rect: Rect, analysis: &mut Forc
         Align2::RIGHT_TOP,
         "now",
     );
+}
+
+/// The bridge surface at `x_m`, linearly between its grid points (None outside the grid).
+fn bridge_height_at(bridge: &BarrierView<MAX_BRIDGE_POINTS>, x_m: f32) -> Option<f32> {
+    let positions = &bridge.positions_m[..bridge.len];
+    let after = positions.iter().position(|&x| x >= x_m)?;
+    if after == 0 {
+        return (positions[0] == x_m).then_some(bridge.heights_m[0]);
+    }
+    let (x0, x1) = (positions[after - 1], positions[after]);
+    let (y0, y1) = (bridge.heights_m[after - 1], bridge.heights_m[after]);
+    Some(y0 + (y1 - y0) * (x_m - x0) / (x1 - x0))
 }
 
 /// Black → blue → orange → white for levels 0..1.
