@@ -319,16 +319,21 @@ mod tests {
         let attempts = 100_000;
         let mut outcomes = [0usize; 4];
         let mut slowest = Duration::ZERO;
+        let all = std::time::Instant::now();
         for _ in 0..attempts {
             let start = std::time::Instant::now();
             let outcome = publisher.end_block(&engine, block, Duration::ZERO);
             slowest = slowest.max(start.elapsed());
             outcomes[outcome as usize] += 1;
         }
+        // Printed, not asserted (house rule: no wall-time assertions); the slowest call is
+        // bounded by the OS scheduler on a shared machine, the mean is the real cost.
         println!(
-            "{attempts} offers to a stalled consumer: {} published, {} dropped, slowest {:?}",
+            "{attempts} offers to a stalled consumer: {} published, {} dropped, mean {:?} per \
+             offer (snapshot fill included), slowest {:?}",
             outcomes[Publication::Published as usize],
             outcomes[Publication::Dropped as usize],
+            all.elapsed() / attempts as u32,
             slowest
         );
         assert_eq!(outcomes[Publication::Published as usize], QUEUE_FRAMES);
