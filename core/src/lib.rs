@@ -23,6 +23,7 @@ pub mod excitation;
 pub mod newton;
 pub mod quality;
 pub mod snapshot;
+pub mod snapshot_channel;
 pub mod string_operator;
 pub mod tanpura;
 pub mod tanpura_string;

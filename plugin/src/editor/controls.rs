@@ -90,13 +90,24 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
                 "Frequency-dependent loss η (Kelvin–Voigt on tension and stiffness): decay grows as η ω²/2, so high partials die first. Higher sounds darker.");
         });
         group(ui, "Bowing", |ui| {
-            ui.label(
-                RichText::new(
-                    "The bowed voice has no plugin parameters yet: the plugin plays the tanpura.",
-                )
-                .small()
-                .italics(),
-            );
+            row(ui, setter, &params.instrument,
+                "Tanpura: MIDI notes pluck strings. Bowed: one bowed string (McIntyre–Schumacher–Woodhouse), played legato from MIDI.");
+            row(ui, setter, &params.bow_model,
+                "Rounded corner: the bow sticks and slips on a friction curve, with smooth reflections at bridge and finger. Bow table: STK's cheaper reflection table.");
+            row(ui, setter, &params.bowed_string,
+                "The string's tension, mass and losses: a violin A string or a cello D string.");
+            row(ui, setter, &params.bow_pressure_percent,
+                "Bow force as a fraction of Schelleng's playable range for the current bow speed and position: too little and the string slips twice per period (surface sound), too much and it no longer releases (raucous). Channel pressure and CC 2 move it.");
+            row(ui, setter, &params.bow_velocity_m_s,
+                "Bow speed. Louder with faster bowing; key velocity and CC 11 move it.");
+            row(ui, setter, &params.bow_position,
+                "Distance of the bow from the bridge over the string length (β). Near the bridge (sul ponticello) is bright and needs more force; far (flautando) is soft. CC 74 moves it.");
+            row(ui, setter, &params.glide_ms,
+                "Legato: a note played while another is held glides to its pitch over this time without a new bow attack.");
+            row(ui, setter, &params.vibrato_cents,
+                "Vibrato depth at full modulation wheel (CC 1), at 5.5 Hz.");
+            row(ui, setter, &params.body_enabled,
+                "The violin body's main resonances (air mode, two body modes, bridge hill) on the bridge force.");
         });
         group(ui, "Quality", |ui| {
             row(ui, setter, &params.quality,

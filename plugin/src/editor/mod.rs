@@ -6,7 +6,7 @@
 //! lock-free [`channel`]; the editor pops the newest at each repaint (50 per second) and does
 //! all drawing work (including the FFT) on its own thread.
 
-pub mod channel;
+pub use javari_core::snapshot_channel as channel;
 mod controls;
 mod spectrum;
 mod view;

@@ -4,8 +4,10 @@
 //! `Javari::process` calls them, run under a counting global allocator that counts only the
 //! audio thread's allocations.
 
-use javari::editor::channel::{Publication, SnapshotChannel, SnapshotPublisher, QUEUE_FRAMES};
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
+use javari_core::snapshot_channel::{
+    Publication, SnapshotChannel, SnapshotPublisher, QUEUE_FRAMES,
+};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -74,7 +76,7 @@ fn run(state: EditorState) -> (u64, [usize; 4], u64) {
         let channel = channel.clone();
         let stop = stop.clone();
         std::thread::spawn(move || {
-            let mut receiver = javari::editor::channel::SnapshotReceiver::new(channel);
+            let mut receiver = javari_core::snapshot_channel::SnapshotReceiver::new(channel);
             while !stop.load(Ordering::Acquire) {
                 receiver.poll();
                 std::thread::sleep(std::time::Duration::from_millis(5));

@@ -10,9 +10,9 @@
 //!
 //! The editor ([`SnapshotReceiver`]) pops whatever has arrived and keeps the newest.
 
+use crate::engine::Engine;
+use crate::snapshot::{OutputHistory, TanpuraSnapshot};
 use crossbeam::queue::ArrayQueue;
-use javari_core::engine::Engine;
-use javari_core::snapshot::{OutputHistory, TanpuraSnapshot};
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -292,7 +292,7 @@ impl SnapshotReceiver {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use javari_core::engine::{EngineEvent, EngineSettings, TimedEvent};
+    use crate::engine::{EngineEvent, EngineSettings, TimedEvent};
 
     fn engine() -> Engine {
         Engine::new(&EngineSettings::default(), 44_100.0, 4)
