@@ -21,6 +21,8 @@
 //! Grids larger than the snapshot's arrays are shown every `stride`-th point, so the picture
 //! stays correct (a subset of the true points) for any grid the quality tiers may use.
 
+use crate::bowed::instrument::BOW_HISTORY_SAMPLES;
+use crate::bowed::BowedInstrument;
 use crate::newton::NewtonStats;
 use crate::tanpura_string::TanpuraString;
 
@@ -141,6 +143,53 @@ pub struct TanpuraSnapshot {
     pub realtime_load: f32,
     pub cap_hits_since_last_frame: u64,
     pub mean_iterations_since_last_frame: f32,
+    /// The bowed string, when the bowed instrument plays.
+    pub bowed: BowedView,
+}
+
+/// What the editor shows of the bowed string: the bow on the string, the stick/slip state and
+/// the bow-point velocity waveform.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BowedView {
+    /// True when the bowed instrument plays (the other fields are meaningful).
+    pub active: bool,
+    /// Bow position β, pitch (Hz), bow force (N) and bow speed (m/s) of the last sample.
+    pub bow_position: f64,
+    pub pitch_hz: f64,
+    pub bow_force_n: f64,
+    pub bow_velocity_m_s: f64,
+    /// The last samples' bow-point velocity, m/s, and whether the string stuck to the bow,
+    /// oldest first.
+    pub velocity_m_s: [f32; BOW_HISTORY_SAMPLES],
+    pub sticking: [bool; BOW_HISTORY_SAMPLES],
+}
+
+impl BowedView {
+    pub const EMPTY: Self = Self {
+        active: false,
+        bow_position: 0.0,
+        pitch_hz: 0.0,
+        bow_force_n: 0.0,
+        bow_velocity_m_s: 0.0,
+        velocity_m_s: [0.0; BOW_HISTORY_SAMPLES],
+        sticking: [false; BOW_HISTORY_SAMPLES],
+    };
+
+    /// Copies the instrument's controls and bow history. Allocation-free.
+    pub fn fill(&mut self, instrument: &BowedInstrument) {
+        let controls = instrument.controls();
+        self.active = true;
+        self.bow_position = controls.bow_position;
+        self.pitch_hz = controls.pitch_hz;
+        self.bow_force_n = controls.bow_force_n;
+        self.bow_velocity_m_s = controls.bow_velocity_m_s;
+        instrument.bow_history(&mut self.velocity_m_s, &mut self.sticking);
+    }
+
+    /// Whether the string stuck to the bow at the last sample.
+    pub fn sticking_now(&self) -> bool {
+        self.sticking[BOW_HISTORY_SAMPLES - 1]
+    }
 }
 
 impl Default for TanpuraSnapshot {
@@ -194,6 +243,7 @@ impl TanpuraSnapshot {
         realtime_load: 0.0,
         cap_hits_since_last_frame: 0,
         mean_iterations_since_last_frame: 0.0,
+        bowed: BowedView::EMPTY,
     };
 
     /// Copies the state of `string` (shape, barriers, contact, forces, its Newton statistics).

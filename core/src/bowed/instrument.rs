@@ -19,7 +19,8 @@
 //! allocation-free.
 
 use super::{
-    BowTableString, BowedCapacity, BowedConfigError, BowedString, BowedVoice, StringConstants,
+    BowTableString, BowedCapacity, BowedConfigError, BowedString, BowedVoice, ContactState,
+    StringConstants,
 };
 
 /// Which bowed model plays.
@@ -114,6 +115,8 @@ pub fn schelleng_max_force_n(impedance_n_s_m: f64, bow_velocity_m_s: f64, beta: 
 }
 
 const MAX_HELD_NOTES: usize = 16;
+/// Samples of bow-point velocity and contact state kept for the editor's view.
+pub const BOW_HISTORY_SAMPLES: usize = 1024;
 const CONTROL_SMOOTHING_S: f64 = 0.01;
 
 /// The controls the string receives, after mapping and smoothing.
@@ -153,6 +156,11 @@ pub struct BowedInstrument {
     lift_per_sample: f64,
     /// 1 while bowing, falling to 0 as the bow lifts.
     contact: f64,
+    /// The last samples' bow-point velocity (m/s) and whether the string stuck to the bow,
+    /// in a ring written at `history_write`.
+    velocity_history: Vec<f32>,
+    sticking_history: Vec<bool>,
+    history_write: usize,
 }
 
 impl BowedInstrument {
@@ -190,6 +198,9 @@ impl BowedInstrument {
             smoothing: 1.0 - (-1.0 / (CONTROL_SMOOTHING_S * sample_rate_hz)).exp(),
             lift_per_sample: 0.0,
             contact: 0.0,
+            velocity_history: vec![0.0; BOW_HISTORY_SAMPLES],
+            sticking_history: vec![false; BOW_HISTORY_SAMPLES],
+            history_write: 0,
         };
         instrument.set_settings(settings);
         instrument.reset();
@@ -214,6 +225,9 @@ impl BowedInstrument {
 
     /// Silence: bow lifted, strings at rest, held notes forgotten.
     pub fn reset(&mut self) {
+        self.velocity_history.fill(0.0);
+        self.sticking_history.fill(false);
+        self.history_write = 0;
         self.rounded.reset();
         self.table.reset();
         self.held_count = 0;
@@ -376,7 +390,38 @@ impl BowedInstrument {
         voice.set_bow_velocity_m_s(controls.bow_velocity_m_s);
         voice.set_bow_position(controls.bow_position);
         voice.set_bow_force_n(controls.bow_force_n);
-        voice.next_sample().radiated
+        let output = voice.next_sample();
+        // Sticking: the string moves with the bow (the rounded corner reports its branch; for
+        // the bow table, equal velocities within 0.1 % of the bow speed).
+        let sticking = match self.settings.tier {
+            BowTier::RoundedCorner => {
+                self.rounded.last_bow_point().state == ContactState::Sticking
+                    && controls.bow_force_n > 0.0
+            }
+            BowTier::BowTable => {
+                controls.bow_force_n > 0.0
+                    && (output.bow_point_velocity_m_s - controls.bow_velocity_m_s).abs()
+                        <= 1e-3 * controls.bow_velocity_m_s.abs()
+            }
+        };
+        self.velocity_history[self.history_write] = output.bow_point_velocity_m_s as f32;
+        self.sticking_history[self.history_write] = sticking;
+        self.history_write = (self.history_write + 1) % BOW_HISTORY_SAMPLES;
+        output.radiated
+    }
+
+    /// Copies the last [`BOW_HISTORY_SAMPLES`] bow-point velocities (m/s) and sticking flags,
+    /// oldest first. Allocation-free.
+    pub fn bow_history(
+        &self,
+        velocities: &mut [f32; BOW_HISTORY_SAMPLES],
+        sticking: &mut [bool; BOW_HISTORY_SAMPLES],
+    ) {
+        for k in 0..BOW_HISTORY_SAMPLES {
+            let index = (self.history_write + k) % BOW_HISTORY_SAMPLES;
+            velocities[k] = self.velocity_history[index];
+            sticking[k] = self.sticking_history[index];
+        }
     }
 }
 
@@ -470,6 +515,35 @@ mod tests {
         }
         assert_eq!(player.controls().bow_force_n, 0.0);
         assert!(!player.is_bowing());
+    }
+
+    #[test]
+    fn bow_history_holds_the_last_samples_oldest_first_with_sticking_in_helmholtz_motion() {
+        let mut player = instrument();
+        player.handle(BowedEvent::NoteOn {
+            note: 57,
+            velocity: 0.5,
+        });
+        for _ in 0..22_050 {
+            player.next_sample();
+        }
+        let mut velocities = [0.0f32; BOW_HISTORY_SAMPLES];
+        let mut sticking = [false; BOW_HISTORY_SAMPLES];
+        player.bow_history(&mut velocities, &mut sticking);
+        // Helmholtz motion at β = 0.1: sticking about 90 % of the time, at the bow's speed.
+        let stuck = sticking.iter().filter(|&&s| s).count() as f64 / BOW_HISTORY_SAMPLES as f64;
+        assert!((0.8..0.95).contains(&stuck), "{stuck}");
+        let bow = player.controls().bow_velocity_m_s as f32;
+        for (v, s) in velocities.iter().zip(&sticking) {
+            if *s {
+                assert!((v - bow).abs() < 1e-4, "{v} vs {bow}");
+            }
+        }
+        // The newest entry is the last sample's velocity.
+        let last = velocities[BOW_HISTORY_SAMPLES - 1];
+        player.next_sample();
+        player.bow_history(&mut velocities, &mut sticking);
+        assert_eq!(velocities[BOW_HISTORY_SAMPLES - 2], last);
     }
 
     #[test]

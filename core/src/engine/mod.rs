@@ -331,6 +331,13 @@ impl Engine {
         }) else {
             return;
         };
+        if self.target.instrument == Instrument::Bowed {
+            snapshot
+                .bowed
+                .fill(&self.bowed[self.target.bowed.string.index()]);
+        } else {
+            snapshot.bowed.active = false;
+        }
         let string = shown.voice.string();
         snapshot.fill_string(string);
         snapshot.active_voices = self.active_voices();

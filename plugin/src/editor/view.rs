@@ -6,7 +6,7 @@
 use super::spectrum::{ForceAnalysis, DYNAMIC_RANGE_DB, MAX_SHOWN_HZ, SPECTROGRAM_ROWS};
 use crate::params::JavariParams;
 use egui::{self, pos2, vec2, Align2, Color32, FontId, Painter, Pos2, Rect, Sense, Shape, Stroke};
-use javari_core::snapshot::{BarrierView, TanpuraSnapshot, MAX_BRIDGE_POINTS};
+use javari_core::snapshot::{BarrierView, BowedView, TanpuraSnapshot, MAX_BRIDGE_POINTS};
 
 const STRING_COLOUR: Color32 = Color32::from_rgb(240, 220, 140);
 const REST_COLOUR: Color32 = Color32::from_rgb(110, 110, 120);
@@ -108,10 +108,119 @@ pub fn live_view(
 
     let pluck_position_m = f64::from(params.pluck_position_mm.value()) / 1000.0;
     whole_string(&painter, string_rect, snapshot, pluck_position_m);
-    close_up(&painter, close_up_rect, snapshot);
+    if snapshot.bowed.active {
+        bow_view(&painter, close_up_rect, &snapshot.bowed);
+    } else {
+        close_up(&painter, close_up_rect, snapshot);
+    }
     force_strip(&painter, force_rect, snapshot);
     spectrum(&painter, spectrum_rect, analysis);
     spectrogram(ui, &painter, spectrogram_rect, analysis);
+}
+
+const STICK_COLOUR: Color32 = Color32::from_rgb(120, 220, 120);
+const SLIP_COLOUR: Color32 = Color32::from_rgb(255, 120, 90);
+
+/// The bowed string: the bow's place on the string (bridge left, finger right), the stick/slip
+/// state now, and the bow-point velocity over the last samples, green where the string sticks to
+/// the bow and red where it slips.
+fn bow_view(painter: &Painter, rect: Rect, bowed: &BowedView) {
+    let state = if bowed.bow_force_n <= 0.0 {
+        "bow lifted"
+    } else if bowed.sticking_now() {
+        "sticking"
+    } else {
+        "slipping"
+    };
+    frame(
+        painter,
+        rect,
+        &format!(
+            "Bowed string: β = {:.3}, F_b = {:.3} N, v_b = {:.3} m/s, {:.1} Hz: {state}",
+            bowed.bow_position, bowed.bow_force_n, bowed.bow_velocity_m_s, bowed.pitch_hz
+        ),
+    );
+    let plot = inner(rect);
+    // The string and the bow, to scale along its length.
+    let string_y = plot.top() + 14.0;
+    painter.line_segment(
+        [pos2(plot.left(), string_y), pos2(plot.right(), string_y)],
+        Stroke::new(2.0, STRING_COLOUR),
+    );
+    label(
+        painter,
+        pos2(plot.left(), string_y + 4.0),
+        Align2::LEFT_TOP,
+        "bridge",
+    );
+    label(
+        painter,
+        pos2(plot.right(), string_y + 4.0),
+        Align2::RIGHT_TOP,
+        "finger",
+    );
+    let bow_x = plot.left() + bowed.bow_position as f32 * plot.width();
+    let bow_colour = if bowed.sticking_now() {
+        STICK_COLOUR
+    } else {
+        SLIP_COLOUR
+    };
+    painter.rect_filled(
+        Rect::from_center_size(pos2(bow_x, string_y), vec2(6.0, 22.0)),
+        1.0,
+        bow_colour,
+    );
+    // Bow-point velocity waveform.
+    let wave = Rect::from_min_max(pos2(plot.left(), string_y + 24.0), plot.max);
+    let peak = bowed
+        .velocity_m_s
+        .iter()
+        .fold(1e-6f32, |m, v| m.max(v.abs()))
+        * 1.1;
+    let axes = Axes {
+        rect: wave,
+        x: (0.0, bowed.velocity_m_s.len() as f64),
+        y: (-f64::from(peak), f64::from(peak)),
+    };
+    painter.line_segment(
+        [
+            axes.point(0.0, 0.0),
+            axes.point(bowed.velocity_m_s.len() as f64, 0.0),
+        ],
+        Stroke::new(1.0, GRID_COLOUR),
+    );
+    for (i, pair) in bowed.velocity_m_s.windows(2).enumerate() {
+        let colour = if bowed.sticking[i + 1] {
+            STICK_COLOUR
+        } else {
+            SLIP_COLOUR
+        };
+        painter.line_segment(
+            [
+                axes.point(i as f64, f64::from(pair[0])),
+                axes.point(i as f64 + 1.0, f64::from(pair[1])),
+            ],
+            Stroke::new(1.2, colour),
+        );
+    }
+    label(
+        painter,
+        pos2(wave.left() - 4.0, wave.top()),
+        Align2::RIGHT_TOP,
+        format!("{peak:.2} m/s"),
+    );
+    label(
+        painter,
+        pos2(wave.left() - 4.0, wave.bottom()),
+        Align2::RIGHT_BOTTOM,
+        format!("{:.2} m/s", -peak),
+    );
+    label(
+        painter,
+        pos2(wave.right(), wave.bottom()),
+        Align2::RIGHT_BOTTOM,
+        "bow-point velocity, last 1024 samples (green: sticking, red: slipping)",
+    );
 }
 
 fn inner(rect: Rect) -> Rect {
