@@ -9,7 +9,9 @@ use super::channel::SnapshotChannel;
 use crate::params::{JavariParams, PresetChoice};
 use crate::FACTORY_PRESET_FILES;
 use egui::{self, Color32, RichText};
+use javari_core::engine::bowed_stability::{bowed_stability, BowedStability};
 use javari_core::engine::pitch::note_to_hz;
+use javari_core::engine::BowedStringKind;
 use javari_core::snapshot::TanpuraSnapshot;
 use nice_plug::prelude::{Enum, Param, ParamSetter};
 use nice_plug_egui::widgets::ParamSlider;
@@ -33,6 +35,50 @@ fn row<P: Param>(
             .on_hover_text(tooltip)
     })
     .inner
+}
+
+/// Woodhouse's stability verdict for the bow as set, at the open string, shown under the
+/// bowing controls (a warning in red when the Helmholtz motion is unstable). The analysis takes
+/// about 20 ms, so its result is kept in egui's memory until a bow control changes.
+fn stability_line(ui: &mut egui::Ui, params: &JavariParams) {
+    let bowed = params.engine_settings(&crate::factory_presets()).bowed;
+    let open_string_note = match bowed.string {
+        BowedStringKind::ViolinA => 69,
+        BowedStringKind::CelloD => 50,
+    };
+    let key = (
+        bowed.pressure.to_bits(),
+        bowed.bow_velocity_m_s.to_bits(),
+        bowed.bow_position.to_bits(),
+        open_string_note,
+    );
+    let id = egui::Id::unique(("bow-stability", key));
+    let verdict = ui
+        .data_mut(|data| data.get_temp::<Option<BowedStability>>(id))
+        .unwrap_or_else(|| {
+            let verdict = bowed_stability(&bowed, open_string_note).ok();
+            ui.data_mut(|data| data.insert_temp(id, verdict));
+            verdict
+        });
+    let text = match verdict {
+        Some(v) if v.stable => RichText::new(format!(
+            "Helmholtz motion stable at the open string: bow force {:.2} N, margin {:.1}× (Woodhouse)",
+            v.bow_force_n, v.margin
+        ))
+        .small()
+        .color(Color32::from_rgb(120, 200, 120)),
+        Some(v) => RichText::new(format!(
+            "Warning: Helmholtz motion unstable at the open string: bow force {:.2} N above the critical {:.2} N",
+            v.bow_force_n,
+            v.critical_bow_force_n.unwrap_or(0.0)
+        ))
+        .small()
+        .color(Color32::from_rgb(255, 110, 90)),
+        None => RichText::new("No stability verdict for these bow settings").small(),
+    };
+    ui.label(text).on_hover_text(
+        "Woodhouse's linear stability analysis (1993) of the Helmholtz motion for the bow force, speed and position set here: above the critical force the motion breaks into raucous or subharmonic playing.",
+    );
 }
 
 fn group(ui: &mut egui::Ui, title: &str, contents: impl FnOnce(&mut egui::Ui)) {
@@ -108,6 +154,7 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
                 "Vibrato depth at full modulation wheel (CC 1), at 5.5 Hz.");
             row(ui, setter, &params.body_enabled,
                 "The violin body's main resonances (air mode, two body modes, bridge hill) on the bridge force.");
+            stability_line(ui, params);
         });
         group(ui, "Quality", |ui| {
             row(ui, setter, &params.quality,
