@@ -66,14 +66,19 @@ pub fn power_spectrum(signal: &[f64], start: usize, n: usize, fft_size: usize) -
 }
 
 /// |Σ x[i] w[i] e^{−2πi f i / fs}|² for one frequency (Hann-windowed DFT at any frequency).
-pub fn windowed_dft_power(signal: &[f64], sample_rate_hz: f64, frequency_hz: f64) -> f64 {
+pub fn windowed_dft_power<T: Copy + Into<f64>>(
+    signal: &[T],
+    sample_rate_hz: f64,
+    frequency_hz: f64,
+) -> f64 {
     let n = signal.len();
     let omega = 2.0 * PI * frequency_hz / sample_rate_hz;
     let (mut re, mut im) = (0.0, 0.0);
     // Rotate a phasor instead of calling sin/cos per sample; renormalise to stop drift.
     let (step_sin, step_cos) = omega.sin_cos();
     let (mut c, mut s) = (1.0f64, 0.0f64);
-    for (i, x) in signal.iter().enumerate() {
+    for (i, &sample) in signal.iter().enumerate() {
+        let x: f64 = sample.into();
         let w = 0.5 - 0.5 * (2.0 * PI * i as f64 / n as f64).cos();
         re += x * w * c;
         im -= x * w * s;

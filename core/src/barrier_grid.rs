@@ -269,8 +269,10 @@ impl BarrierGrid {
         }
     }
 
-    /// Adds `I* C I` into `jacobian`, whose row r is string node r + 1.
-    pub fn add_jacobian(&self, jacobian: &mut SymmetricBanded) {
+    /// Calls `add(row_node, column_node, value)` for every entry of `I* C I` on free nodes
+    /// (both triangles), from the candidates' Jacobian entries `c_i`.
+    #[inline]
+    fn for_each_jacobian_entry(&self, mut add: impl FnMut(usize, usize, f64)) {
         let last_free = self.string_intervals - 1;
         for &i in self.candidate_indices() {
             let stiffness = self.transpose_scale * self.jacobian[i];
@@ -284,42 +286,32 @@ impl BarrierGrid {
                 if !(1..=last_free).contains(&row_node) {
                     continue;
                 }
-                for k in 0..=j {
+                for k in 0..4 {
                     let column_node = first + k;
-                    if !(1..=last_free).contains(&column_node) {
-                        continue;
+                    if (1..=last_free).contains(&column_node) {
+                        add(row_node, column_node, stiffness * w[j] * w[k]);
                     }
-                    jacobian.add(row_node - 1, column_node - 1, stiffness * w[j] * w[k]);
                 }
             }
         }
     }
 
+    /// Adds `I* C I` into `jacobian`, whose row r is string node r + 1.
+    pub fn add_jacobian(&self, jacobian: &mut SymmetricBanded) {
+        // The banded storage holds each symmetric pair once: add the lower triangle only.
+        self.for_each_jacobian_entry(|row_node, column_node, value| {
+            if column_node <= row_node {
+                jacobian.add(row_node - 1, column_node - 1, value);
+            }
+        });
+    }
+
     /// Adds the block of `I* C I` on nodes `first_node..first_node + size` into the dense
     /// row-major `size × size` matrix `dense` (every stencil must lie inside that block).
     pub fn add_jacobian_dense(&self, dense: &mut [f64], size: usize, first_node: usize) {
-        let last_free = self.string_intervals - 1;
-        for &i in self.candidate_indices() {
-            let stiffness = self.transpose_scale * self.jacobian[i];
-            if stiffness == 0.0 {
-                continue;
-            }
-            let first = self.stencil_first_node[i];
-            let w = &self.stencil_weights[i];
-            for j in 0..4 {
-                let row_node = first + j;
-                if !(1..=last_free).contains(&row_node) {
-                    continue;
-                }
-                let row = row_node - first_node;
-                for k in 0..4 {
-                    let column_node = first + k;
-                    if (1..=last_free).contains(&column_node) {
-                        dense[row * size + column_node - first_node] += stiffness * w[j] * w[k];
-                    }
-                }
-            }
-        }
+        self.for_each_jacobian_entry(|row_node, column_node, value| {
+            dense[(row_node - first_node) * size + column_node - first_node] += value;
+        });
     }
 
     /// Whether the last [`evaluate`](Self::evaluate) found any point exerting a force.

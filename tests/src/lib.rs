@@ -261,27 +261,7 @@ pub fn plugin_library() -> PathBuf {
 
 /// Magnitude of the Hann-windowed signal's spectrum at `frequency_hz` (one DTFT bin).
 pub fn windowed_magnitude(signal: &[f32], sample_rate_hz: f64, frequency_hz: f64) -> f64 {
-    let length = signal.len() as f64;
-    let omega = 2.0 * std::f64::consts::PI * frequency_hz / sample_rate_hz;
-    let (mut real, mut imaginary) = (0.0, 0.0);
-    // The phasor is advanced by rotation, renormalised every 1024 samples against drift.
-    let (step_sin, step_cos) = omega.sin_cos();
-    let (mut sin, mut cos) = (0.0f64, 1.0f64);
-    for (n, sample) in signal.iter().enumerate() {
-        let window = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * n as f64 / length).cos();
-        let value = f64::from(*sample) * window;
-        real += value * cos;
-        imaginary -= value * sin;
-        let next_cos = cos * step_cos - sin * step_sin;
-        sin = sin * step_cos + cos * step_sin;
-        cos = next_cos;
-        if n % 1024 == 1023 {
-            let norm = (sin * sin + cos * cos).sqrt();
-            sin /= norm;
-            cos /= norm;
-        }
-    }
-    (real * real + imaginary * imaginary).sqrt()
+    javari_core::analysis::windowed_dft_power(signal, sample_rate_hz, frequency_hz).sqrt()
 }
 
 /// The frequency of the strongest spectral peak within ±`search_cents` of `expected_hz`:
