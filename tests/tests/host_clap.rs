@@ -29,11 +29,17 @@ impl HostHandlers for TestHost {
 
 const PLUGIN_ID: &[u8] = b"org.javari.tanpura";
 
-fn load_entry() -> PluginEntry {
-    let library = plugin_library();
-    // SAFETY: the library is this repository's own plugin, built by this `cargo test`.
-    unsafe { PluginEntry::load(&library) }
-        .unwrap_or_else(|error| panic!("loading {}: {error:?}", library.display()))
+/// The plugin's entry, loaded once for every test of this file and never unloaded: tests run
+/// in parallel threads, and unloading the library under another test's running instance would
+/// pull its code away (as a host never does).
+fn load_entry() -> &'static PluginEntry {
+    static ENTRY: std::sync::OnceLock<PluginEntry> = std::sync::OnceLock::new();
+    ENTRY.get_or_init(|| {
+        let library = plugin_library();
+        // SAFETY: the library is this repository's own plugin, built by this `cargo test`.
+        unsafe { PluginEntry::load(&library) }
+            .unwrap_or_else(|error| panic!("loading {}: {error:?}", library.display()))
+    })
 }
 
 fn instantiate(entry: &PluginEntry) -> PluginInstance<TestHost> {
@@ -157,7 +163,7 @@ fn clap_plays_in_tune_at_several_rates_and_block_sizes() {
     let entry = load_entry();
     let key = 57u16; // A3, 220 Hz
     for (sample_rate, block_size) in [(44_100.0, 512usize), (48_000.0, 33), (96_000.0, 1024)] {
-        let mut instance = instantiate(&entry);
+        let mut instance = instantiate(entry);
         let note_at = 100;
         let (left, right) = play(
             &mut instance,
@@ -214,7 +220,7 @@ fn parameter_id(instance: &mut PluginInstance<TestHost>, name: &str) -> ClapId {
 #[test]
 fn clap_automation_is_allocation_free_and_keeps_the_string_in_tune() {
     let entry = load_entry();
-    let mut instance = instantiate(&entry);
+    let mut instance = instantiate(entry);
     let quality = parameter_id(&mut instance, "Quality");
     let thread = parameter_id(&mut instance, "Thread");
     let stiffness = parameter_id(&mut instance, "Bridge stiffness");
@@ -244,7 +250,7 @@ fn clap_automation_is_allocation_free_and_keeps_the_string_in_tune() {
 #[test]
 fn clap_state_round_trip_restores_parameters() {
     let entry = load_entry();
-    let mut first = instantiate(&entry);
+    let mut first = instantiate(entry);
     let state_extension = first
         .plugin_handle()
         .get_extension::<PluginState>()
@@ -259,7 +265,7 @@ fn clap_state_round_trip_restores_parameters() {
     // Change the output gain in the saved state (0 dB → −6.02 dB), load it into a fresh
     // instance, and check that it plays half as loud and saves the new value back.
     let edited = edit_parameter(&text, "gain", -6.0206);
-    let mut second = instantiate(&entry);
+    let mut second = instantiate(entry);
     let extension = second
         .plugin_handle()
         .get_extension::<PluginState>()
