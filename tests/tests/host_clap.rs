@@ -4,8 +4,9 @@
 //! finite, and round-trip the plugin state. The cdylib is built with `assert_process_allocs`,
 //! so an allocation in `process` aborts this test.
 
+use clack_extensions::params::{ParamInfoBuffer, PluginParams};
 use clack_extensions::state::PluginState;
-use clack_host::events::event_types::NoteOnEvent;
+use clack_host::events::event_types::{NoteOnEvent, ParamValueEvent};
 use clack_host::prelude::*;
 use javari_core::engine::pitch::{cents, note_to_hz};
 use javari_tests::{peak, peak_frequency_near, plugin_library};
@@ -28,11 +29,17 @@ impl HostHandlers for TestHost {
 
 const PLUGIN_ID: &[u8] = b"org.javari.tanpura";
 
-fn load_entry() -> PluginEntry {
-    let library = plugin_library();
-    // SAFETY: the library is this repository's own plugin, built by this `cargo test`.
-    unsafe { PluginEntry::load(&library) }
-        .unwrap_or_else(|error| panic!("loading {}: {error:?}", library.display()))
+/// The plugin's entry, loaded once for every test of this file and never unloaded: tests run
+/// in parallel threads, and unloading the library under another test's running instance would
+/// pull its code away (as a host never does).
+fn load_entry() -> &'static PluginEntry {
+    static ENTRY: std::sync::OnceLock<PluginEntry> = std::sync::OnceLock::new();
+    ENTRY.get_or_init(|| {
+        let library = plugin_library();
+        // SAFETY: the library is this repository's own plugin, built by this `cargo test`.
+        unsafe { PluginEntry::load(&library) }
+            .unwrap_or_else(|error| panic!("loading {}: {error:?}", library.display()))
+    })
 }
 
 fn instantiate(entry: &PluginEntry) -> PluginInstance<TestHost> {
@@ -60,6 +67,26 @@ fn play(
     note_at: usize,
     seconds: f64,
 ) -> (Vec<f32>, Vec<f32>) {
+    play_automated(
+        instance,
+        sample_rate,
+        block_size,
+        (key, velocity, note_at),
+        &[],
+        seconds,
+    )
+}
+
+/// As [`play`], with parameter changes `(sample, parameter id, plain value)` sent as CLAP
+/// parameter events at their samples.
+fn play_automated(
+    instance: &mut PluginInstance<TestHost>,
+    sample_rate: f64,
+    block_size: usize,
+    (key, velocity, note_at): (u16, f64, usize),
+    automation: &[(usize, ClapId, f64)],
+    seconds: f64,
+) -> (Vec<f32>, Vec<f32>) {
     let configuration = PluginAudioConfiguration {
         sample_rate,
         min_frames_count: 1,
@@ -79,16 +106,24 @@ fn play(
     let mut start = 0;
     while start < total {
         let frames = block_size.min(total - start);
-        let note_in_block = (start..start + frames).contains(&note_at);
-        let events = if note_in_block {
-            vec![NoteOnEvent::new(
+        let block = start..start + frames;
+        let mut events = EventBuffer::new();
+        if block.contains(&note_at) {
+            events.push(&NoteOnEvent::new(
                 (note_at - start) as u32,
                 Pckn::new(0u16, 0u16, key, 0u32),
                 velocity,
-            )]
-        } else {
-            Vec::new()
-        };
+            ));
+        }
+        for &(at, id, value) in automation.iter().filter(|(at, ..)| block.contains(at)) {
+            events.push(&ParamValueEvent::new(
+                (at - start) as u32,
+                id,
+                Pckn::match_all(),
+                value,
+            ));
+        }
+        events.sort();
         let input_events = InputEvents::from_buffer(&events);
         let mut output_events = OutputEvents::from_buffer(&mut output_events);
         let input_audio = input_ports.with_input_buffers(std::iter::empty::<
@@ -128,7 +163,7 @@ fn clap_plays_in_tune_at_several_rates_and_block_sizes() {
     let entry = load_entry();
     let key = 57u16; // A3, 220 Hz
     for (sample_rate, block_size) in [(44_100.0, 512usize), (48_000.0, 33), (96_000.0, 1024)] {
-        let mut instance = instantiate(&entry);
+        let mut instance = instantiate(entry);
         let note_at = 100;
         let (left, right) = play(
             &mut instance,
@@ -155,10 +190,67 @@ fn clap_plays_in_tune_at_several_rates_and_block_sizes() {
     }
 }
 
+/// The CLAP id of the parameter shown as `name`, from the params extension.
+fn parameter_id(instance: &mut PluginInstance<TestHost>, name: &str) -> ClapId {
+    let handle = instance.plugin_handle();
+    let params = handle
+        .get_extension::<PluginParams>()
+        .expect("the params extension");
+    let mut buffer = ParamInfoBuffer::new();
+    (0..params.count(&handle))
+        .filter_map(|index| {
+            params
+                .get_info(&handle, index, &mut buffer)
+                .map(|i| (i.id, i.name.to_vec()))
+        })
+        .find(|(_, info_name)| {
+            let end = info_name
+                .iter()
+                .position(|b| *b == 0)
+                .unwrap_or(info_name.len());
+            &info_name[..end] == name.as_bytes()
+        })
+        .map(|(id, _)| id)
+        .unwrap_or_else(|| panic!("no parameter named {name}"))
+}
+
+/// Automation while a string rings, under the allocation guard: switching the quality tier,
+/// the thread off and on, and moving k_b and the thread must neither allocate in `process`
+/// nor produce a non-finite sample, and the string stays in tune.
+#[test]
+fn clap_automation_is_allocation_free_and_keeps_the_string_in_tune() {
+    let entry = load_entry();
+    let mut instance = instantiate(entry);
+    let quality = parameter_id(&mut instance, "Quality");
+    let thread = parameter_id(&mut instance, "Thread");
+    let stiffness = parameter_id(&mut instance, "Bridge stiffness");
+    let position = parameter_id(&mut instance, "Thread position");
+    let rate = 44_100.0;
+    let automation = [
+        (2_000, stiffness, 9.0),
+        (4_000, position, 35.0),
+        (6_000, thread, 0.0),
+        (8_000, quality, 3.0), // Reference
+        (9_000, thread, 1.0),
+        (10_000, quality, 0.0), // Draft
+        (12_000, stiffness, 8.0),
+        (12_001, position, 40.0),
+    ];
+    let (left, _) = play_automated(&mut instance, rate, 128, (57, 0.4, 0), &automation, 0.8);
+    assert!(left.iter().all(|x| x.is_finite()), "non-finite sample");
+    let settled = &left[(0.4 * rate) as usize..];
+    let level = peak(settled);
+    let expected = note_to_hz(57);
+    let error = cents(peak_frequency_near(settled, rate, expected, 60.0), expected);
+    println!("after automation: peak {level:.4}, A3 {error:+.2} cents");
+    assert!(level > 1e-3, "the string still rings: {level}");
+    assert!(error.abs() < 5.0, "{error} cents");
+}
+
 #[test]
 fn clap_state_round_trip_restores_parameters() {
     let entry = load_entry();
-    let mut first = instantiate(&entry);
+    let mut first = instantiate(entry);
     let state_extension = first
         .plugin_handle()
         .get_extension::<PluginState>()
@@ -173,7 +265,7 @@ fn clap_state_round_trip_restores_parameters() {
     // Change the output gain in the saved state (0 dB → −6.02 dB), load it into a fresh
     // instance, and check that it plays half as loud and saves the new value back.
     let edited = edit_parameter(&text, "gain", -6.0206);
-    let mut second = instantiate(&entry);
+    let mut second = instantiate(entry);
     let extension = second
         .plugin_handle()
         .get_extension::<PluginState>()

@@ -179,17 +179,12 @@ impl Module {
     }
 }
 
-impl Drop for Module {
-    fn drop(&mut self) {
-        unsafe {
-            if let Ok(exit) = self
-                .library
-                .get::<unsafe extern "C" fn() -> bool>(b"ModuleExit")
-            {
-                exit();
-            }
-        }
-    }
+/// The module, entered once for every test of this file and never exited or unloaded: tests
+/// run in parallel threads, and `ModuleExit` or unloading under another test's running instance
+/// would pull the plugin away from it (as a host never does).
+fn module() -> &'static Module {
+    static MODULE: std::sync::OnceLock<Module> = std::sync::OnceLock::new();
+    MODULE.get_or_init(Module::load)
 }
 
 fn note_on(offset: i32, key: i16, velocity: f32) -> Event {
@@ -290,7 +285,7 @@ fn play(
 
 #[test]
 fn vst3_plays_in_tune_at_several_rates_and_block_sizes() {
-    let module = Module::load();
+    let module = module();
     let key = 57; // A3, 220 Hz
     for (sample_rate, block_size) in [(44_100.0, 256usize), (48_000.0, 100), (88_200.0, 2048)] {
         let (component, processor) = module.instantiate();
@@ -323,7 +318,7 @@ fn vst3_plays_in_tune_at_several_rates_and_block_sizes() {
 
 #[test]
 fn vst3_state_round_trip() {
-    let module = Module::load();
+    let module = module();
     let (first, first_processor) = module.instantiate();
     let saved = ComWrapper::new(MemoryStream {
         bytes: RefCell::new(Vec::new()),

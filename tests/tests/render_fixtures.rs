@@ -166,3 +166,29 @@ fn full_velocity_pitch_glides_in() {
     assert!((-9.0..=-4.0).contains(&early), "{early}");
     assert!(late.abs() < 2.0, "{late}");
 }
+
+#[test]
+fn every_factory_preset_loads_and_plays_in_tune() {
+    let presets = ["classic", "no-thread", "bright-jawari", "soft"];
+    for name in presets {
+        let path = javari_tests::repository_root()
+            .join("presets")
+            .join(format!("{name}.toml"));
+        let preset = javari_core::engine::preset::Preset::load(&path).unwrap();
+        let mut score = Score::default();
+        score.note(0.0, 0.2, 57, 0.4);
+        let options = options(512, 0.6);
+        let signal = render(&preset.settings, &score, &options, &mut |_, _| {});
+        assert!(signal.iter().all(|x| x.is_finite()), "{name}: NaN or Inf");
+        let peak_dbfs = 20.0 * f64::from(peak(&signal)).log10();
+        let window = &signal[(0.1 * RATE) as usize..];
+        let measured = peak_frequency_near(window, RATE, note_to_hz(57), 60.0);
+        let error = cents(measured, note_to_hz(57));
+        println!("{name}: peak {peak_dbfs:.2} dBFS, A3 {error:+.2} cents");
+        assert!(
+            (-40.0..0.0).contains(&peak_dbfs),
+            "{name}: {peak_dbfs} dBFS"
+        );
+        assert!(error.abs() < 5.0, "{name}: {error} cents");
+    }
+}

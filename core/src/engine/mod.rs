@@ -9,6 +9,8 @@
 //! - note to pitch: 12-TET, A4 = 440 Hz ([`pitch`]);
 //! - drone mode ([`drone`]): a held note sets Sa and the four strings are plucked in the classic
 //!   cycle at the host's tempo;
+//! - a change of quality tier applies to each string from its next pluck (a voice switching tier
+//!   restarts at rest, which would silence a ringing string);
 //! - smoothing of continuous settings in SI units ([`smoothing`]): the string settings move at
 //!   a control rate of one update every [`CONTROL_INTERVAL`] samples (a string's settings change
 //!   rebuilds its step matrix, so it is not done per sample), reaching the target in
@@ -532,6 +534,11 @@ impl Engine {
         for slot in &mut self.slots {
             let mut string_settings = settings;
             string_settings.fundamental_hz = slot.fundamental_hz;
+            if slot.voice.is_active() {
+                // A voice switching tier restarts at rest (`TanpuraVoice::set_settings`), so a
+                // ringing string keeps its tier; the new one applies from its next pluck.
+                string_settings.quality = slot.voice.settings().quality;
+            }
             slot.voice.set_settings(&string_settings);
         }
     }
@@ -655,16 +662,17 @@ impl Engine {
     fn pluck_string(&mut self, key: StringKey, fundamental_hz: f64, velocity: f32) {
         let index = self.choose_voice(key, fundamental_hz);
         let slot = &mut self.slots[index];
+        let mut string_settings = self.current_voice;
+        string_settings.fundamental_hz = fundamental_hz;
         if slot.key != Some(key) || slot.fundamental_hz != fundamental_hz {
-            let mut string_settings = self.current_voice;
-            string_settings.fundamental_hz = fundamental_hz;
             // A stolen string is stopped first: its old vibration belongs to another tuning.
             slot.voice.reset();
-            slot.voice.set_settings(&string_settings);
             slot.key = Some(key);
             slot.fundamental_hz = fundamental_hz;
             slot.level_factor = pitch_level_factor(fundamental_hz);
         }
+        // Also brings a re-plucked string to the current quality tier.
+        slot.voice.set_settings(&string_settings);
         let mut pluck = self.target.pluck;
         pluck.amplitude_m *= f64::from(velocity.clamp(0.0, 1.0));
         slot.voice.pluck(&pluck);

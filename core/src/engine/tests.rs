@@ -225,3 +225,23 @@ fn snapshot_equals_the_loudest_string_exactly() {
         assert_eq!(snapshot.active_voices, 2);
     }
 }
+
+#[test]
+fn quality_change_keeps_ringing_strings_and_applies_from_the_next_pluck() {
+    use crate::quality::Quality;
+    let mut engine = Engine::new(&EngineSettings::default(), RATE, 2);
+    run(&mut engine, &[note_on(0, 57)], 2_000);
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Draft;
+    engine.set_settings(&settings);
+    let after = run(&mut engine, &[], 4_410);
+    assert!(peak(&after[4_000..]) > 0.01, "the ringing string goes on");
+    assert_eq!(engine.slots[0].voice.settings().quality, Quality::Reference);
+    run(&mut engine, &[note_on(0, 57)], 64);
+    assert_eq!(engine.slots[0].voice.settings().quality, Quality::Draft);
+    assert_eq!(
+        engine.active_voices(),
+        1,
+        "the same string, now at the new tier"
+    );
+}
