@@ -195,14 +195,7 @@ impl BowTableString {
 
 impl BowedVoice for BowTableString {
     fn prepare(&mut self, sample_rate_hz: f64) -> Result<(), BowedConfigError> {
-        let max_hz = self.capacity.max_sample_rate_hz;
-        if !(MIN_SAMPLE_RATE_HZ..=max_hz).contains(&sample_rate_hz) {
-            return Err(BowedConfigError::SampleRate {
-                requested_hz: sample_rate_hz,
-                min_hz: MIN_SAMPLE_RATE_HZ,
-                max_hz,
-            });
-        }
+        self.capacity.check_sample_rate(sample_rate_hz)?;
         self.sample_rate_hz = sample_rate_hz;
         self.body.prepare(sample_rate_hz);
         self.set_pitch_hz(self.pitch_hz);

@@ -51,6 +51,22 @@ impl Default for BowedCapacity {
     }
 }
 
+impl BowedCapacity {
+    /// Whether a voice built for this capacity accepts `sample_rate_hz` in `prepare()`.
+    pub fn check_sample_rate(&self, sample_rate_hz: f64) -> Result<(), BowedConfigError> {
+        let max_hz = self.max_sample_rate_hz;
+        if (MIN_SAMPLE_RATE_HZ..=max_hz).contains(&sample_rate_hz) {
+            Ok(())
+        } else {
+            Err(BowedConfigError::SampleRate {
+                requested_hz: sample_rate_hz,
+                min_hz: MIN_SAMPLE_RATE_HZ,
+                max_hz,
+            })
+        }
+    }
+}
+
 /// Lowest sample rate a voice accepts, Hz.
 pub const MIN_SAMPLE_RATE_HZ: f64 = 8_000.0;
 
