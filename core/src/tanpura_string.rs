@@ -15,8 +15,8 @@
 //! - bridge: the parabola `y_b(x) = −(x − x_crest)²/(2 R_b)` with crest at 46.5 mm, y = 0, and
 //!   radius of curvature `R_b` = 0.1 m, over 25–60 mm (beyond that the string never reaches it);
 //! - thread: a cap on the bridge surface, `y_c(x) = y_b(x_c) + h_c − (x − x_c)²/(2 R_c)`, with
-//!   height `h_c` = 0.2 mm and an effective radius `R_c` = 20 mm (a compressible cotton thread
-//!   seen through k_c = 1e8 N/m²); at the default 40 mm its top lies 11 µm below the crest, so the
+//!   height `h_c` = 0.18 mm and an effective radius `R_c` = 20 mm (a compressible cotton thread
+//!   seen through k_c = 1e8 N/m²); at the default 40 mm its top lies 31 µm below the crest, so the
 //!   string rests on both and grazes the crest as it vibrates (the jawari);
 //! - finger: a parabolic tip of radius half its width (`excitation.rs`), 1 mm grid.
 //!
