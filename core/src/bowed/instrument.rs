@@ -143,6 +143,10 @@ pub struct BowedInstrument {
     pitch_note: f64,
     target_note: f64,
     glide_per_sample: f64,
+    /// The note number sounding at the last sample (glide, bend and vibrato included) and its
+    /// frequency, Hz.
+    sounding_note: f64,
+    sounding_hz: f64,
     bend_semitones: f64,
     vibrato_depth: f64,
     vibrato_phase: f64,
@@ -187,6 +191,8 @@ impl BowedInstrument {
             pitch_note: 57.0,
             target_note: 57.0,
             glide_per_sample: 0.0,
+            sounding_note: 57.0,
+            sounding_hz: note_to_hz(57.0),
             bend_semitones: 0.0,
             vibrato_depth: 0.0,
             vibrato_phase: 0.0,
@@ -360,9 +366,18 @@ impl BowedInstrument {
         if self.vibrato_phase >= 1.0 {
             self.vibrato_phase -= 1.0;
         }
-        let vibrato_semitones =
-            self.vibrato_depth / 100.0 * (std::f64::consts::TAU * self.vibrato_phase).sin();
-        let pitch_hz = note_to_hz(self.pitch_note + self.bend_semitones + vibrato_semitones);
+        let vibrato_semitones = if self.vibrato_depth > 0.0 {
+            self.vibrato_depth / 100.0 * (std::f64::consts::TAU * self.vibrato_phase).sin()
+        } else {
+            0.0
+        };
+        // powf only when the sounding note moved (glide, bend or vibrato), not every sample.
+        let sounding_note = self.pitch_note + self.bend_semitones + vibrato_semitones;
+        if sounding_note != self.sounding_note {
+            self.sounding_note = sounding_note;
+            self.sounding_hz = note_to_hz(sounding_note);
+        }
+        let pitch_hz = self.sounding_hz;
 
         // Bow contact: on while bowing, lifting linearly after the last note-off.
         self.contact = if self.bowing {
