@@ -56,6 +56,16 @@ pub struct NewtonStats {
 }
 
 impl NewtonStats {
+    /// No steps yet (the `Default`, usable in constants).
+    pub const ZERO: NewtonStats = NewtonStats {
+        steps: 0,
+        steps_without_contact: 0,
+        iterations: 0,
+        max_iterations: 0,
+        cap_hits: 0,
+        last_iterations: 0,
+    };
+
     /// Mean Newton updates per time step.
     pub fn mean_iterations(&self) -> f64 {
         if self.steps == 0 {

@@ -367,6 +367,32 @@ impl TanpuraVoice {
         }
         let mut config = settings.string_config(self.output_sample_rate_hz);
         let string = &mut self.strings[index];
+        if let Some(previous) = self.configured[index] {
+            // The pickup mix does not touch the string at all.
+            let pickup_only = VoiceSettings {
+                nut_pickup_weight: settings.nut_pickup_weight,
+                ..previous
+            };
+            if pickup_only == settings {
+                self.configured[index] = Some(settings);
+                return;
+            }
+            // The losses change the step matrix but not the rest state the tuning is computed
+            // on: keep the tuned tension and skip the inverse iterations (the engine moves γ
+            // and η every control tick while they glide).
+            let losses_and_pickup = VoiceSettings {
+                gamma_per_s: settings.gamma_per_s,
+                eta_s: settings.eta_s,
+                nut_pickup_weight: settings.nut_pickup_weight,
+                ..previous
+            };
+            if losses_and_pickup == settings {
+                config.string.tension_n = string.config().string.tension_n;
+                string.set_config(config);
+                self.configured[index] = Some(settings);
+                return;
+            }
+        }
         string.set_config(config);
         for _ in 0..TUNING_PASSES {
             let linearised = string.linearised_fundamental_hz();

@@ -291,3 +291,31 @@ fn a_sleeping_string_wakes_exactly_on_its_next_pluck() {
         }
     }
 }
+
+#[test]
+fn changing_only_the_losses_keeps_the_tuning_a_full_retune_would_give() {
+    for quality in Quality::ALL {
+        let before = VoiceSettings {
+            quality,
+            ..VoiceSettings::default()
+        };
+        let after = VoiceSettings {
+            gamma_per_s: 5.0,
+            eta_s: 3e-7,
+            nut_pickup_weight: 0.3,
+            ..before
+        };
+        let mut changed = TanpuraVoice::new(&before, 44_100.0);
+        changed.set_settings(&after);
+        let fresh = TanpuraVoice::new(&after, 44_100.0);
+        assert_eq!(
+            changed.string().config(),
+            fresh.string().config(),
+            "{quality:?}"
+        );
+        assert_eq!(
+            changed.string().rest_nut_force_n(),
+            fresh.string().rest_nut_force_n()
+        );
+    }
+}
