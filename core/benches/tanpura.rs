@@ -3,17 +3,17 @@
 //! configuration (Δx = 3.34 mm, 4 × 44.1 kHz, full Newton to 1e-13 m through the condensed
 //! solver), with the Newton iteration statistics. Also the plain full-Newton reference path.
 
-use javari_core::excitation::Pluck;
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::fd::{FdString, FdStringConfig, SolverKind};
 use javari_core::tanpura::{Tanpura, VoiceSettings};
-use javari_core::tanpura_string::{SolverKind, TanpuraString, TanpuraStringConfig};
 use std::time::Instant;
 
 const SECONDS: f64 = 2.0;
 
 fn one_string(solver: SolverKind) {
-    let mut config = TanpuraStringConfig::REFERENCE;
+    let mut config = FdStringConfig::REFERENCE;
     config.solver = solver;
-    let mut string = TanpuraString::new(config);
+    let mut string = FdString::new(config);
     string.pluck(&Pluck::default());
     let steps = (SECONDS / config.time_step_s) as usize;
     let start = Instant::now();

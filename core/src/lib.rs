@@ -12,18 +12,11 @@
 pub mod bowed;
 pub mod stability;
 
+pub mod tanpura;
+
 pub mod analysis;
 pub mod banded;
-pub mod barrier_grid;
-pub mod condensed;
-pub mod contact;
-pub mod decimator;
 pub mod engine;
-pub mod excitation;
 pub mod newton;
-pub mod quality;
 pub mod snapshot;
 pub mod snapshot_channel;
-pub mod string_operator;
-pub mod tanpura;
-pub mod tanpura_string;

@@ -4,12 +4,12 @@
 //! queue (`plugin/src/editor/channel.rs`), so the snapshot is a plain fixed-size `Copy` value:
 //! filling it never allocates, and moving it through a bounded queue is a memcpy.
 //!
-//! What it holds, all taken from [`TanpuraString`]'s accessors at the moment of the fill (a unit
+//! What it holds, all taken from [`FdString`]'s accessors at the moment of the fill (a unit
 //! test checks each field against them):
 //! - the displacement `y` and the rest shape over the string grid, with the node positions (the
 //!   view of the seed's Figure 3);
 //! - the bridge and thread barriers near the bridge: point positions and heights of
-//!   [`TanpuraString::bridge_grid`] and [`TanpuraString::thread_grid`], and per point whether the
+//!   [`FdString::bridge_grid`] and [`FdString::thread_grid`], and per point whether the
 //!   string penetrates it, `a_i = y_barrier(x_i) − (I y)_i > 0` (seed 000, eq. 17–19: the points
 //!   where the Hunt–Crossley force acts);
 //! - the deepest penetration, the nut and bridge forces (eq. 12–13) and the Newton statistics;
@@ -24,7 +24,7 @@
 use crate::bowed::instrument::BOW_HISTORY_SAMPLES;
 use crate::bowed::BowedInstrument;
 use crate::newton::NewtonStats;
-use crate::tanpura_string::TanpuraString;
+use crate::tanpura::fd::FdString;
 
 /// String nodes a snapshot holds (the seed's grid has 201).
 pub const MAX_STRING_NODES: usize = 256;
@@ -68,7 +68,11 @@ impl<const CAPACITY: usize> BarrierView<CAPACITY> {
         self.in_contact[..self.len].iter().filter(|&&c| c).count()
     }
 
-    fn fill(&mut self, barrier: &crate::barrier_grid::BarrierGrid, displacement_m: &[f64]) {
+    fn fill(
+        &mut self,
+        barrier: &crate::tanpura::fd::barrier_grid::BarrierGrid,
+        displacement_m: &[f64],
+    ) {
         let (len, stride) = fit(barrier.len(), CAPACITY);
         self.len = len;
         self.stride = stride;
@@ -234,7 +238,7 @@ impl TanpuraSnapshot {
 
     /// Copies the state of `string` (shape, barriers, contact, forces, its Newton statistics).
     /// Allocation-free.
-    pub fn fill_string(&mut self, string: &TanpuraString) {
+    pub fn fill_string(&mut self, string: &FdString) {
         let config = string.config();
         let displacement = string.displacement_m();
         let rest = string.rest_displacement_m();
@@ -332,12 +336,12 @@ impl OutputHistory {
 pub(crate) mod tests {
     use super::*;
     use crate::engine::{pitch, Engine, EngineEvent, EngineSettings, TimedEvent};
-    use crate::excitation::Pluck;
+    use crate::tanpura::excitation::Pluck;
+    use crate::tanpura::fd::FdStringConfig;
     use crate::tanpura::TanpuraVoice;
-    use crate::tanpura_string::TanpuraStringConfig;
 
     /// Every field of `snapshot` that `fill_string` wrote equals the string's own accessors.
-    pub(crate) fn assert_snapshot_is_string(snapshot: &TanpuraSnapshot, string: &TanpuraString) {
+    pub(crate) fn assert_snapshot_is_string(snapshot: &TanpuraSnapshot, string: &FdString) {
         let config = string.config();
         let y = string.displacement_m();
         let rest = string.rest_displacement_m();
@@ -393,7 +397,7 @@ pub(crate) mod tests {
 
     #[test]
     fn snapshot_of_a_ringing_string_equals_its_state_field_by_field() {
-        let mut string = TanpuraString::new(TanpuraStringConfig::REFERENCE);
+        let mut string = FdString::new(FdStringConfig::REFERENCE);
         string.pluck(&Pluck::default());
         let mut snapshot = TanpuraSnapshot::default();
         let mut contacts_seen = 0;
@@ -421,9 +425,9 @@ pub(crate) mod tests {
         assert_eq!(fit(257, 256), (129, 2));
         assert_eq!(fit(401, 256), (201, 2));
         assert_eq!(fit(0, 64), (0, 1));
-        let mut config = TanpuraStringConfig::REFERENCE;
+        let mut config = FdStringConfig::REFERENCE;
         config.intervals = 400;
-        let string = TanpuraString::new(config);
+        let string = FdString::new(config);
         let mut snapshot = TanpuraSnapshot::default();
         snapshot.fill_string(&string);
         assert_eq!((snapshot.node_count, snapshot.node_stride), (201, 2));

@@ -4,7 +4,7 @@
 
 use javari_core::engine::render::{render, RenderOptions, Score};
 use javari_core::engine::{EngineSettings, Instrument};
-use javari_core::quality::Quality;
+use javari_core::tanpura::quality::Quality;
 
 fn score() -> Score {
     let mut score = Score::default();

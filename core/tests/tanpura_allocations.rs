@@ -2,7 +2,7 @@
 //! instrument (40 000 string steps at 4× oversampling, with plucks and a retune in between)
 //! under a counting global allocator.
 
-use javari_core::excitation::Pluck;
+use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::{FirstString, Tanpura, VoiceSettings};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};

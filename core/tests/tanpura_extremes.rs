@@ -5,8 +5,8 @@
 //! few times the string tension, energy that does not grow (beyond round-off where the scheme is
 //! conservative), and Newton cap hits counted and rare.
 
-use javari_core::excitation::Pluck;
-use javari_core::quality::Quality;
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
 
 const SECONDS: f64 = 0.03;

@@ -4,22 +4,22 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use javari_core::excitation::Pluck;
 use javari_core::newton::NewtonSettings;
-use javari_core::tanpura_string::{SolverKind, TanpuraString, TanpuraStringConfig};
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::fd::{FdString, FdStringConfig, SolverKind};
 use std::f64::consts::PI;
 
 const SAMPLE_RATE: f64 = 176_400.0;
 
-fn plucked(config: TanpuraStringConfig) -> TanpuraString {
-    let mut string = TanpuraString::new(config);
+fn plucked(config: FdStringConfig) -> FdString {
+    let mut string = FdString::new(config);
     string.pluck(&Pluck::default());
     string
 }
 
 #[test]
 fn lossless_energy_is_conserved_to_round_off_in_sustained_contact() {
-    let mut config = TanpuraStringConfig::REFERENCE.lossless();
+    let mut config = FdStringConfig::REFERENCE.lossless();
     config.track_energy = true;
     let mut string = plucked(config);
     let initial = string.energy_j();
@@ -38,7 +38,7 @@ fn lossless_energy_is_conserved_to_round_off_in_sustained_contact() {
 
 #[test]
 fn lossy_energy_balance_holds_and_newton_never_hits_its_cap_over_two_seconds() {
-    let mut config = TanpuraStringConfig::REFERENCE;
+    let mut config = FdStringConfig::REFERENCE;
     config.track_energy = true;
     let mut string = plucked(config);
     let initial = string.energy_j();
@@ -82,7 +82,7 @@ fn zero_crossing_frequency(signal: &[f64], sample_rate: f64) -> f64 {
 }
 
 /// The first ten modal coordinates `Σ_m (y_m − y_rest,m) sin(nπm/N)` over `seconds`.
-fn modal_histories(string: &mut TanpuraString, seconds: f64, rate: f64) -> Vec<Vec<f64>> {
+fn modal_histories(string: &mut FdString, seconds: f64, rate: f64) -> Vec<Vec<f64>> {
     let n = string.config().intervals;
     let rest = string.rest_displacement_m().to_vec();
     let shapes: Vec<Vec<f64>> = (1..=10)
@@ -104,8 +104,8 @@ fn modal_histories(string: &mut TanpuraString, seconds: f64, rate: f64) -> Vec<V
     histories
 }
 
-fn linear_string(intervals: usize, rate: f64, lossless: bool) -> TanpuraStringConfig {
-    let mut config = TanpuraStringConfig::REFERENCE;
+fn linear_string(intervals: usize, rate: f64, lossless: bool) -> FdStringConfig {
+    let mut config = FdStringConfig::REFERENCE;
     config.intervals = intervals;
     config.time_step_s = 1.0 / rate;
     config.bridge.stiffness_n_m2 = 0.0;
@@ -118,7 +118,7 @@ fn linear_string(intervals: usize, rate: f64, lossless: bool) -> TanpuraStringCo
 
 #[test]
 fn linear_string_partials_follow_the_stiff_string_formula_with_second_order_error() {
-    let p = TanpuraStringConfig::REFERENCE.string;
+    let p = FdStringConfig::REFERENCE.string;
     let length = p.length_m;
     let f0 = p.wave_speed_m_s() / (2.0 * length);
     let b = PI * PI * p.bending_stiffness_n_m2 / (p.tension_n * length * length);
@@ -194,7 +194,7 @@ fn decay_rate(signal: &[f64], sample_rate: f64) -> f64 {
 
 #[test]
 fn decay_rates_of_the_first_ten_partials_match_the_loss_model() {
-    let p = TanpuraStringConfig::REFERENCE.string;
+    let p = FdStringConfig::REFERENCE.string;
     let mut string = plucked(linear_string(200, SAMPLE_RATE, false));
     let histories = modal_histories(&mut string, 0.5, SAMPLE_RATE);
     for (index, history) in histories.iter().enumerate() {
@@ -212,7 +212,7 @@ fn decay_rates_of_the_first_ten_partials_match_the_loss_model() {
 
 #[test]
 fn string_at_rest_touches_bridge_and_thread_and_penetrates_under_five_percent_of_diameter() {
-    let string = TanpuraString::new(TanpuraStringConfig::REFERENCE);
+    let string = FdString::new(FdStringConfig::REFERENCE);
     let diameter = 0.3e-3;
     let rest = string.rest_displacement_m();
     for (name, grid) in [
@@ -233,7 +233,7 @@ fn string_at_rest_touches_bridge_and_thread_and_penetrates_under_five_percent_of
 
 #[test]
 fn penetration_stays_under_five_percent_of_diameter_while_ringing() {
-    let mut string = plucked(TanpuraStringConfig::REFERENCE);
+    let mut string = plucked(FdStringConfig::REFERENCE);
     let mut deepest = 0.0f64;
     for _ in 0..(0.1 * SAMPLE_RATE) as usize {
         string.step();
@@ -245,7 +245,7 @@ fn penetration_stays_under_five_percent_of_diameter_while_ringing() {
 
 #[test]
 fn a_capped_newton_completes_every_step_and_counts_the_hits() {
-    let mut config = TanpuraStringConfig::REFERENCE;
+    let mut config = FdStringConfig::REFERENCE;
     config.newton = NewtonSettings {
         tolerance_m: 1e-15,
         max_iterations: 1,
@@ -265,7 +265,7 @@ fn a_capped_newton_completes_every_step_and_counts_the_hits() {
 #[test]
 fn two_runs_are_bit_identical() {
     let run = || {
-        let mut string = plucked(TanpuraStringConfig::REFERENCE);
+        let mut string = plucked(FdStringConfig::REFERENCE);
         (0..20_000)
             .map(|_| {
                 string.step();
@@ -282,7 +282,7 @@ fn two_runs_are_bit_identical() {
 #[test]
 fn condensed_solver_agrees_with_full_newton() {
     let run = |solver: SolverKind| {
-        let mut config = TanpuraStringConfig::REFERENCE;
+        let mut config = FdStringConfig::REFERENCE;
         config.solver = solver;
         let mut string = plucked(config);
         (0..5000)

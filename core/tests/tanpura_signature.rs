@@ -4,7 +4,7 @@
 //! independently and the upper partials' share of the energy never grows.
 
 use javari_core::analysis::{band_power, power_spectrum, spectral_centroid_hz};
-use javari_core::excitation::Pluck;
+use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
 
 const SAMPLE_RATE: f64 = 44_100.0;

@@ -311,7 +311,10 @@ mod tests {
         assert!((settings.voice.bridge_stiffness_n_m2 / 1e8 - 1.0).abs() < 1e-6);
         assert!((settings.voice.thread_position_m - 0.040).abs() < 1e-9);
         assert!((settings.voice.eta_s / 7e-9 - 1.0).abs() < 1e-6);
-        assert_eq!(settings.voice.quality, javari_core::quality::Quality::Live);
+        assert_eq!(
+            settings.voice.quality,
+            javari_core::tanpura::quality::Quality::Live
+        );
         assert_eq!(settings.drone, expected.drone);
     }
 
@@ -322,7 +325,7 @@ mod tests {
         assert_eq!(classic.voice, default.voice);
         assert_eq!(
             classic.voice.quality,
-            javari_core::quality::Quality::Reference,
+            javari_core::tanpura::quality::Quality::Reference,
             "a preset without a quality key keeps the default tier"
         );
         assert_eq!(classic.pluck, default.pluck);

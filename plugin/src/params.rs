@@ -41,10 +41,10 @@ use javari_core::engine::preset::{
 use javari_core::engine::{
     BowedEngineSettings, BowedStringKind, EngineSettings, Instrument, OUTPUT_GAIN_RANGE_DB,
 };
-use javari_core::excitation::Pluck;
-use javari_core::quality::Quality;
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::geometry::ThreadSettings;
+use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{FirstString, VoiceSettings};
-use javari_core::tanpura_string::ThreadSettings;
 use nice_plug::prelude::*;
 use std::sync::Arc;
 

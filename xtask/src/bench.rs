@@ -16,9 +16,9 @@ use javari_core::analysis::{
     band_power, cents, peak_frequency_hz, power_spectrum, spectral_centroid_hz,
 };
 use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
-use javari_core::excitation::Pluck;
 use javari_core::newton::NewtonStats;
-use javari_core::quality::Quality;
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{FirstString, Tanpura, TanpuraVoice, VoiceSettings};
 use std::error::Error;
 use std::fmt::Write as _;

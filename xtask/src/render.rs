@@ -25,7 +25,7 @@ use javari_core::engine::render::ScoreAction;
 use javari_core::engine::render::{render, rendered_length, RenderOptions, Score};
 use javari_core::engine::wav::write_wav;
 use javari_core::engine::{EngineEvent, EngineSettings, Instrument};
-use javari_core::quality::Quality;
+use javari_core::tanpura::quality::Quality;
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;

@@ -1,13 +1,14 @@
 //! `cargo xtask simulate`: a researcher's probe of one tanpura string.
 //!
-//! Runs one `TanpuraString` at the internal rate and writes a CSV with the columns
+//! Runs one `FdString` at the internal rate and writes a CSV with the columns
 //! `time_s,nut_force_n,bridge_force_n,energy_j,losses_j,newton_iterations,max_penetration_m`
 //! (every step, or every `--every N` steps), and optionally a WAV of the nut force (minus its
 //! rest value) at the internal rate, normalised to its peak.
 
 use crate::args::{ArgError, Args};
-use javari_core::excitation::Pluck;
-use javari_core::tanpura_string::{TanpuraString, TanpuraStringConfig, ThreadSettings};
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::fd::{FdString, FdStringConfig};
+use javari_core::tanpura::geometry::ThreadSettings;
 use std::error::Error;
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -33,7 +34,7 @@ pub const HELP: &str = "cargo xtask simulate [options]
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimulateOptions {
     pub seconds: f64,
-    pub config: TanpuraStringConfig,
+    pub config: FdStringConfig,
     pub first_mode: bool,
     pub pluck: Pluck,
     pub every: usize,
@@ -71,7 +72,7 @@ pub fn parse(raw: &[String]) -> Result<SimulateOptions, ArgError> {
         ));
     }
 
-    let mut config = TanpuraStringConfig::REFERENCE;
+    let mut config = FdStringConfig::REFERENCE;
     config.time_step_s = 1.0 / (44_100.0 * oversample as f64);
     config.bridge.stiffness_n_m2 = kb;
     config.bridge.beyond_thread = bridge == "full";
@@ -104,7 +105,7 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn Error>> {
         return Ok(());
     }
     let options = parse(raw)?;
-    let mut string = TanpuraString::new(options.config);
+    let mut string = FdString::new(options.config);
     if options.first_mode {
         string.excite_first_mode(options.pluck.amplitude_m);
     } else {
@@ -189,8 +190,8 @@ mod tests {
     #[test]
     fn defaults_are_the_seed_reference() {
         let options = parse(&[]).unwrap();
-        assert_eq!(options.config.bridge, TanpuraStringConfig::REFERENCE.bridge);
-        assert_eq!(options.config.thread, TanpuraStringConfig::REFERENCE.thread);
+        assert_eq!(options.config.bridge, FdStringConfig::REFERENCE.bridge);
+        assert_eq!(options.config.thread, FdStringConfig::REFERENCE.thread);
         assert_eq!(options.config.time_step_s, 1.0 / 176_400.0);
         assert!(!options.first_mode);
     }

@@ -34,7 +34,7 @@ pub mod smoothing;
 pub mod wav;
 
 use crate::bowed::{BowedEvent, BowedInstrument, BowedPlayerSettings, StringConstants};
-use crate::excitation::Pluck;
+use crate::tanpura::excitation::Pluck;
 use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
 use drone::{string_ratios, DroneSequencer, DroneSettings};
 use smoothing::Ramp;

@@ -37,10 +37,10 @@
 use super::drone::TEMPO_RANGE_BPM;
 use super::{BowedStringKind, EngineSettings, Instrument, OUTPUT_GAIN_RANGE_DB};
 use crate::bowed::BowTier;
-use crate::excitation::Pluck;
-use crate::quality::Quality;
+use crate::tanpura::excitation::Pluck;
+use crate::tanpura::geometry::ThreadSettings;
+use crate::tanpura::quality::Quality;
 use crate::tanpura::{FirstString, VoiceSettings};
-use crate::tanpura_string::ThreadSettings;
 use std::fmt;
 use std::path::Path;
 

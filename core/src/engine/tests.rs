@@ -228,7 +228,7 @@ fn snapshot_equals_the_loudest_string_exactly() {
 
 #[test]
 fn quality_change_keeps_ringing_strings_and_applies_from_the_next_pluck() {
-    use crate::quality::Quality;
+    use crate::tanpura::quality::Quality;
     let mut engine = Engine::new(&EngineSettings::default(), RATE, 2);
     run(&mut engine, &[note_on(0, 57)], 2_000);
     let mut settings = EngineSettings::default();

@@ -14,7 +14,7 @@
 //! is measured by `cargo xtask bench`.
 
 use crate::newton::NewtonSettings;
-use crate::tanpura_string::SolverKind;
+use crate::tanpura::fd::SolverKind;
 
 /// The four tiers, cheapest first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]

@@ -1,11 +1,10 @@
-//! The tanpura voice (one string at an oversampled rate, decimated to the output rate) and the
-//! four-string instrument.
+//! The tanpura voice: one string, its tuning, its quality tier and its sleep.
 //!
 //! A voice holds one string per quality tier (`quality.rs`), all built up front, so switching
 //! tiers never allocates; only the selected tier's string is computed, and switching starts it
 //! at rest.
 //!
-//! A voice maps musician-facing settings in SI units onto [`TanpuraString`]: the tension follows
+//! A voice maps musician-facing settings in SI units onto [`FdString`]: the tension follows
 //! the pitch, `T = ρA (2 L_s f)² / (1 + B)` with the speaking length `L_s` from the thread (or the
 //! bridge crest) to the nut and the stiff-string correction `B = π² EI / (T L_s²)` (solved by a
 //! fixed-point pass); the scheme runs at `oversample ×` the output rate (seed 000: 4 × 44.1 kHz)
@@ -17,12 +16,13 @@
 //! pluck) is put exactly at rest and sleeps: no computation at all until its next pluck, once the
 //! decimator's tail has been flushed.
 
-use crate::decimator::Decimator;
-use crate::excitation::Pluck;
+use super::excitation::Pluck;
+use super::fd::decimator::Decimator;
+use super::fd::{FdString, FdStringConfig};
+use super::geometry::ThreadSettings;
+use super::quality::Quality;
+use super::string::StringParameters;
 use crate::newton::NewtonStats;
-use crate::quality::Quality;
-use crate::string_operator::StringParameters;
-use crate::tanpura_string::{TanpuraString, TanpuraStringConfig, ThreadSettings};
 use std::fmt;
 
 /// Vibration energy below which a string sleeps, J. A 2 mm pluck holds about 4e-4 J.
@@ -58,7 +58,7 @@ pub struct VoiceSettings {
 
 /// The string pitch at which the seed's tension (31.47 N) is reached with the default thread.
 pub fn reference_fundamental_hz() -> f64 {
-    let config = TanpuraStringConfig::REFERENCE;
+    let config = FdStringConfig::REFERENCE;
     let speaking = config.string.length_m - config.speaking_start_m();
     let p = config.string;
     let stiffness_factor = 1.0
@@ -186,18 +186,14 @@ impl VoiceSettings {
 
     /// The string configuration these settings describe at `output_sample_rate_hz`, at the
     /// settings' own quality tier.
-    pub fn string_config(&self, output_sample_rate_hz: f64) -> TanpuraStringConfig {
+    pub fn string_config(&self, output_sample_rate_hz: f64) -> FdStringConfig {
         self.string_config_at(self.quality, output_sample_rate_hz)
     }
 
     /// The string configuration at a given quality tier.
-    pub fn string_config_at(
-        &self,
-        quality: Quality,
-        output_sample_rate_hz: f64,
-    ) -> TanpuraStringConfig {
+    pub fn string_config_at(&self, quality: Quality, output_sample_rate_hz: f64) -> FdStringConfig {
         let tier = quality.tier();
-        let mut config = TanpuraStringConfig::REFERENCE;
+        let mut config = FdStringConfig::REFERENCE;
         config.intervals = tier.intervals;
         config.time_step_s = 1.0 / (output_sample_rate_hz * tier.oversample as f64);
         config.bridge.spacing_m *= tier.barrier_spacing_scale;
@@ -228,7 +224,7 @@ impl VoiceSettings {
 /// `fundamental_hz`: `f = (1/2L_s) √(T/ρA) √(1 + B)`, `B = π² EI/(T L_s²)`, solved for T by
 /// fixed point.
 pub fn tension_for_pitch_n(
-    config: &TanpuraStringConfig,
+    config: &FdStringConfig,
     speaking_start_m: f64,
     fundamental_hz: f64,
 ) -> f64 {
@@ -266,7 +262,7 @@ fn dispersion_per_n_squared(
 /// its `B` by `2(c_tier − c_reference)` cancels the difference to leading order, so the first ten
 /// partials of every tier stay close to the reference's. The reference keeps the seed's EI.
 fn dispersion_compensated_stiffness(
-    config: &TanpuraStringConfig,
+    config: &FdStringConfig,
     quality: Quality,
     fundamental_hz: f64,
     output_sample_rate_hz: f64,
@@ -301,7 +297,7 @@ pub struct TanpuraVoice {
     settings: VoiceSettings,
     output_sample_rate_hz: f64,
     /// One string per quality tier, indexed by [`Quality::index`].
-    strings: Vec<TanpuraString>,
+    strings: Vec<FdString>,
     /// The settings each tier's string was last configured for.
     configured: Vec<Option<VoiceSettings>>,
     /// One decimator per oversampling factor, built up front.
@@ -322,7 +318,7 @@ impl TanpuraVoice {
                 // Built with a thread so that its grid exists if it is switched on later.
                 let mut build = settings;
                 build.thread_enabled = true;
-                TanpuraString::new(build.string_config_at(quality, output_sample_rate_hz))
+                FdString::new(build.string_config_at(quality, output_sample_rate_hz))
             })
             .collect();
         let decimators = (1..=MAX_OVERSAMPLE).map(Decimator::new).collect();
@@ -341,12 +337,12 @@ impl TanpuraVoice {
         voice
     }
 
-    fn string_mut(&mut self) -> &mut TanpuraString {
+    fn string_mut(&mut self) -> &mut FdString {
         &mut self.strings[self.settings.quality.index()]
     }
 
     /// The string of the selected tier.
-    pub fn string(&self) -> &TanpuraString {
+    pub fn string(&self) -> &FdString {
         &self.strings[self.settings.quality.index()]
     }
 
@@ -356,7 +352,7 @@ impl TanpuraVoice {
 
     /// Configures the selected tier's string for the settings and tunes it: the tension is
     /// scaled until the linearised fundamental of the string resting on bridge and thread
-    /// ([`TanpuraString::linearised_fundamental_hz`]) is the requested pitch. The contact
+    /// ([`FdString::linearised_fundamental_hz`]) is the requested pitch. The contact
     /// geometry makes the speaking length differ from "thread to nut" by up to 1 %, which
     /// would be 18 cents; two passes of `T ← T (f / f_lin)²` bring it under 0.1 cent.
     fn configure_string(&mut self) {
@@ -523,117 +519,5 @@ impl TanpuraVoice {
     /// Output latency of the decimation filter, samples at the output rate.
     pub fn latency_samples(&self) -> f64 {
         self.decimators[self.oversample() - 1].delay_output_samples()
-    }
-}
-
-/// The interval of the first drone string below Sa.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FirstString {
-    /// The fifth: 3/4 of Sa (Pa of the lower octave).
-    Pa,
-    /// The fourth: 2/3 of Sa (Ma of the lower octave).
-    Ma,
-    /// The major seventh: 15/16 of Sa (Ni of the lower octave).
-    Ni,
-}
-
-impl FirstString {
-    /// Frequency ratio to Sa.
-    pub fn ratio(self) -> f64 {
-        match self {
-            FirstString::Pa => 3.0 / 4.0,
-            FirstString::Ma => 2.0 / 3.0,
-            FirstString::Ni => 15.0 / 16.0,
-        }
-    }
-}
-
-/// The four-string drone: first string (Pa, Ma or Ni), Sa, Sa, low Sa.
-#[derive(Debug, Clone)]
-pub struct Tanpura {
-    voices: [TanpuraVoice; 4],
-    settings: VoiceSettings,
-    sa_hz: f64,
-    first_string: FirstString,
-}
-
-impl Tanpura {
-    /// Frequency ratios of the four strings to Sa for a given first string.
-    pub fn tuning(first_string: FirstString) -> [f64; 4] {
-        [first_string.ratio(), 1.0, 1.0, 0.5]
-    }
-
-    /// The instrument tuned to `sa_hz`; `settings` apply to every string except its pitch.
-    /// Allocates.
-    pub fn new(settings: &VoiceSettings, sa_hz: f64, output_sample_rate_hz: f64) -> Self {
-        let ratios = Self::tuning(FirstString::Pa);
-        let voices = ratios.map(|ratio| {
-            let mut string_settings = *settings;
-            string_settings.fundamental_hz = sa_hz * ratio;
-            TanpuraVoice::new(&string_settings, output_sample_rate_hz)
-        });
-        Self {
-            voices,
-            settings: *settings,
-            sa_hz,
-            first_string: FirstString::Pa,
-        }
-    }
-
-    /// Retunes and reconfigures every string without allocating.
-    pub fn set_tuning(&mut self, settings: &VoiceSettings, sa_hz: f64, first_string: FirstString) {
-        self.settings = *settings;
-        self.sa_hz = sa_hz;
-        self.first_string = first_string;
-        for (voice, ratio) in self.voices.iter_mut().zip(Self::tuning(first_string)) {
-            let mut string_settings = *settings;
-            string_settings.fundamental_hz = sa_hz * ratio;
-            voice.set_settings(&string_settings);
-        }
-    }
-
-    pub fn sa_hz(&self) -> f64 {
-        self.sa_hz
-    }
-
-    pub fn first_string(&self) -> FirstString {
-        self.first_string
-    }
-
-    /// Plucks string `index` (0 = first string … 3 = low Sa); other indices are ignored.
-    pub fn pluck(&mut self, index: usize, pluck: &Pluck) {
-        if let Some(voice) = self.voices.get_mut(index) {
-            voice.pluck(pluck);
-        }
-    }
-
-    /// One output sample: the sum of the four strings' pickups, N. Sleeping strings cost
-    /// nothing.
-    pub fn next_sample(&mut self) -> f32 {
-        self.voices.iter_mut().map(TanpuraVoice::next_sample).sum()
-    }
-
-    pub fn voices(&self) -> &[TanpuraVoice; 4] {
-        &self.voices
-    }
-
-    /// Number of strings currently computing.
-    pub fn active_strings(&self) -> usize {
-        self.voices.iter().filter(|voice| voice.is_active()).count()
-    }
-
-    /// Newton statistics of all four strings together.
-    pub fn newton_stats(&self) -> NewtonStats {
-        let mut stats = NewtonStats::default();
-        for voice in &self.voices {
-            stats.merge(voice.newton_stats());
-        }
-        stats
-    }
-
-    pub fn reset(&mut self) {
-        for voice in &mut self.voices {
-            voice.reset();
-        }
     }
 }

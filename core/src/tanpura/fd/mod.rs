@@ -1,24 +1,23 @@
-//! One tanpura string in distributed contact with a curved bridge and a cotton thread, stepped
-//! one sample of the internal rate at a time.
+//! The seed's finite-difference scheme: one tanpura string in distributed contact with a curved
+//! bridge and a cotton thread, stepped one sample of the internal (oversampled) rate at a time.
+//! The discretisation of the studio and reference tiers.
 //!
 //! Source: seed 000 (van Walstijn & Chatziioannou, ISMA 2014), eq. 5–25, restated in
 //! `shared/notes/tanpura-model.md`; configuration "B" of its Figure 2 (the string runs from the
 //! tuning bead at x = 0, over the thread and the bridge, to the nut at x = L).
 //!
+//! - `operator.rs`: the string's FD operator (eq. 14–16) on the grid Δx, its energy and nut force;
+//! - `barrier_grid.rs`: bridge, thread and finger on their own fine grids, tied to the string by
+//!   cubic Lagrange interpolation and its scaled transpose (eq. 17–25);
+//! - `condensed.rs`: Newton reduced to the contact nodes through a Schur complement;
+//! - `decimator.rs`: the Kaiser FIR from the internal rate to the output rate.
+//!
 //! Each step finds `s = yⁿ⁺¹ − yⁿ` as the root of eq. 22 and updates `yⁿ⁺¹ = yⁿ + s`,
 //! `qⁿ⁺¹ = s − qⁿ` (eq. 16). The step first solves the linear part alone with the prefactorised
 //! `A` (the string without contact). If no barrier point has a positive gap before or after that
 //! step, no contact force acts and the linear step *is* the exact root: Newton is skipped.
-//! Otherwise a bounded Newton iteration (`newton.rs`) starts from it.
-//!
-//! Geometry (the seed's measured bridge profile is not public, so this one is our own):
-//! - bridge: the parabola `y_b(x) = −(x − x_crest)²/(2 R_b)` with crest at 46.5 mm, y = 0, and
-//!   radius of curvature `R_b` = 0.1 m, over 25–60 mm (beyond that the string never reaches it);
-//! - thread: a cap on the bridge surface, `y_c(x) = y_b(x_c) + h_c − (x − x_c)²/(2 R_c)`, with
-//!   height `h_c` = 0.18 mm and an effective radius `R_c` = 20 mm (a compressible cotton thread
-//!   seen through k_c = 1e8 N/m²); at the default 40 mm its top lies 31 µm below the crest, so the
-//!   string rests on both and grazes the crest as it vibrates (the jawari);
-//! - finger: a parabolic tip of radius half its width (`excitation.rs`), 1 mm grid.
+//! Otherwise a bounded Newton iteration (`newton.rs`) starts from it. The barrier profiles are
+//! those of `geometry.rs`; the finger's grid is 1 mm.
 //!
 //! Energy (eq. 8–9): `H = Σ Δx [p²/2ρA] + V_string + Δx_b Σ k_b/2⌊a⌋² + Δx_c Σ k_c/2⌊a⌋²`.
 //! The scheme gives `Hⁿ⁺¹ − Hⁿ = −(losses over the step)` exactly; a pluck changes H by the
@@ -26,109 +25,18 @@
 //! `H(n) + cumulative losses − external work = H(0)` to round-off.
 
 use crate::banded::{BandedLdlt, SymmetricBanded};
-use crate::barrier_grid::{lagrange_stencil, BarrierGrid};
-use crate::condensed::ContactCondensation;
-use crate::excitation::{finger_height_m, first_mode_shape, Pluck};
 use crate::newton::{solve_bounded, NewtonSettings, NewtonStats, NewtonSystem};
-use crate::string_operator::{StringOperator, StringParameters};
+use crate::tanpura::excitation::{finger_height_m, first_mode_shape, Pluck};
+use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
+use crate::tanpura::string::StringParameters;
+use barrier_grid::{lagrange_stencil, BarrierGrid};
+use condensed::ContactCondensation;
+use operator::StringOperator;
 
-/// The curved bridge (a one-sided barrier) and its contact law.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BridgeSettings {
-    /// Position of the crest (highest point, y = 0), m from the tuning bead. Seed: 46.5 mm.
-    pub crest_position_m: f64,
-    /// Radius of curvature of the parabolic profile, m.
-    pub curvature_radius_m: f64,
-    /// Where the bridge grid starts and ends, m.
-    pub start_m: f64,
-    pub end_m: f64,
-    /// Δx_b, m. Seed: 0.18 mm.
-    pub spacing_m: f64,
-    /// k_b, N/m². Seed: 1e8. Zero removes the bridge.
-    pub stiffness_n_m2: f64,
-    /// r_b, s/m. Seed: 0.1.
-    pub damping_s_m: f64,
-    /// False sets k_b = 0 beyond the thread (x > x_c), the seed's Figure 5 comparison.
-    pub beyond_thread: bool,
-}
-
-impl BridgeSettings {
-    pub const SEED: BridgeSettings = BridgeSettings {
-        crest_position_m: 0.0465,
-        curvature_radius_m: 0.1,
-        start_m: 0.025,
-        end_m: 0.060,
-        spacing_m: 0.18e-3,
-        stiffness_n_m2: 1e8,
-        damping_s_m: 0.1,
-        beyond_thread: true,
-    };
-
-    /// Height of the bridge surface at `x`, m.
-    pub fn height_m(&self, x_m: f64) -> f64 {
-        let offset = x_m - self.crest_position_m;
-        -offset * offset / (2.0 * self.curvature_radius_m)
-    }
-}
-
-/// The cotton thread between string and bridge.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ThreadSettings {
-    /// x_c, m from the tuning bead. Seed: 40 mm. Valid 30–45 mm (on the bridge, before its crest).
-    pub position_m: f64,
-    /// Height of the thread's top above the bridge surface, m.
-    pub height_m: f64,
-    /// Effective radius of curvature of its top, m.
-    pub curvature_radius_m: f64,
-    /// Δx_c, m. Seed: 0.15 mm.
-    pub spacing_m: f64,
-    /// k_c, N/m². Seed: 1e8.
-    pub stiffness_n_m2: f64,
-    /// r_c, s/m. Seed: 0.1.
-    pub damping_s_m: f64,
-}
-
-impl ThreadSettings {
-    pub const SEED: ThreadSettings = ThreadSettings {
-        position_m: 0.040,
-        height_m: 0.18e-3,
-        curvature_radius_m: 0.020,
-        spacing_m: 0.15e-3,
-        stiffness_n_m2: 1e8,
-        damping_s_m: 0.1,
-    };
-    pub const POSITION_RANGE_M: (f64, f64) = (0.030, 0.045);
-
-    /// Half the length over which the thread's cap stands above the bridge surface, m.
-    pub fn half_width_m(&self) -> f64 {
-        (2.0 * self.curvature_radius_m * self.height_m).sqrt()
-    }
-
-    fn height_over(&self, bridge: &BridgeSettings, x_m: f64) -> f64 {
-        let offset = x_m - self.position_m;
-        bridge.height_m(self.position_m) + self.height_m
-            - offset * offset / (2.0 * self.curvature_radius_m)
-    }
-}
-
-/// The plucking finger's grid and contact law.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FingerSettings {
-    /// Δx_f, m. Seed: 1 mm.
-    pub spacing_m: f64,
-    /// k_f while pressing, N/m².
-    pub stiffness_n_m2: f64,
-    /// r_f, s/m. Seed: 1.
-    pub damping_s_m: f64,
-}
-
-impl FingerSettings {
-    pub const SEED: FingerSettings = FingerSettings {
-        spacing_m: 1e-3,
-        stiffness_n_m2: 1e8,
-        damping_s_m: 1.0,
-    };
-}
+pub mod barrier_grid;
+pub mod condensed;
+pub mod decimator;
+pub mod operator;
 
 /// How the Newton iteration of each step is solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -143,7 +51,7 @@ pub enum SolverKind {
 
 /// Everything that defines one simulated string.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TanpuraStringConfig {
+pub struct FdStringConfig {
     pub string: StringParameters,
     /// N, grid intervals over the length (200 gives the seed's Δx = 3⅓ mm, to 0.2 %).
     pub intervals: usize,
@@ -159,9 +67,9 @@ pub struct TanpuraStringConfig {
     pub track_energy: bool,
 }
 
-impl TanpuraStringConfig {
+impl FdStringConfig {
     /// The seed's section 5: the reference configuration.
-    pub const REFERENCE: TanpuraStringConfig = TanpuraStringConfig {
+    pub const REFERENCE: FdStringConfig = FdStringConfig {
         string: StringParameters::SEED,
         intervals: 200,
         time_step_s: 1.0 / 176_400.0,
@@ -193,7 +101,7 @@ impl TanpuraStringConfig {
     }
 }
 
-impl Default for TanpuraStringConfig {
+impl Default for FdStringConfig {
     fn default() -> Self {
         Self::REFERENCE
     }
@@ -284,10 +192,10 @@ impl NewtonSystem for StepSolver {
     }
 }
 
-/// One tanpura string; allocation-free after [`TanpuraString::new`].
+/// One tanpura string; allocation-free after [`FdString::new`].
 #[derive(Debug, Clone)]
-pub struct TanpuraString {
-    config: TanpuraStringConfig,
+pub struct FdString {
+    config: FdStringConfig,
     operator: StringOperator,
     solver: StepSolver,
     /// y, full-node vector: y[0] = y_TB, y[N] = 0.
@@ -309,9 +217,9 @@ pub struct TanpuraString {
     non_finite_resets: u64,
 }
 
-impl TanpuraString {
+impl FdString {
     /// Builds the string and settles it at rest on bridge and thread. Allocates.
-    pub fn new(config: TanpuraStringConfig) -> Self {
+    pub fn new(config: FdStringConfig) -> Self {
         let n = config.intervals;
         let operator = StringOperator::new(config.string, n, config.time_step_s);
         let bridge_capacity = grid_points(
@@ -370,7 +278,7 @@ impl TanpuraString {
     /// string was built with one (its grid needs room). Returns false, changing nothing, when
     /// the new configuration does not fit. The string keeps vibrating; its rest state is
     /// recomputed.
-    pub fn set_config(&mut self, config: TanpuraStringConfig) -> bool {
+    pub fn set_config(&mut self, config: FdStringConfig) -> bool {
         let thread_fits = config.thread.is_none_or(|thread| {
             grid_points(0.0, 2.0 * thread.half_width_m(), thread.spacing_m)
                 <= self.solver.thread.capacity()
@@ -897,7 +805,7 @@ impl TanpuraString {
         &self.rest_displacement
     }
 
-    pub fn config(&self) -> &TanpuraStringConfig {
+    pub fn config(&self) -> &FdStringConfig {
         &self.config
     }
 
@@ -1005,7 +913,7 @@ fn max_abs_on(step: &[f64], condensation: Option<&ContactCondensation>) -> f64 {
 
 /// The string nodes that any bridge or thread stencil can reach, for every thread position in
 /// its range: the block the condensed solver iterates on.
-fn contact_node_range(config: &TanpuraStringConfig, spacing_m: f64) -> Option<(usize, usize)> {
+fn contact_node_range(config: &FdStringConfig, spacing_m: f64) -> Option<(usize, usize)> {
     let n = config.intervals;
     let thread_reach = ThreadSettings::SEED
         .half_width_m()
@@ -1031,6 +939,6 @@ fn grid_points(start_m: f64, end_m: f64, spacing_m: f64) -> usize {
 /// Cubic Lagrange interpolation of a full-node vector at a position in grid units.
 fn interpolate_full(values: &[f64], position_in_intervals: f64) -> f64 {
     let intervals = values.len() - 1;
-    let (first, weights) = crate::barrier_grid::lagrange_stencil(position_in_intervals, intervals);
+    let (first, weights) = lagrange_stencil(position_in_intervals, intervals);
     (0..4).map(|j| weights[j] * values[first + j]).sum()
 }

@@ -14,7 +14,7 @@
 //! their step is zero, which costs nothing in the energy balance.
 
 use crate::banded::SymmetricBanded;
-use crate::contact::{potential_density, HuntCrossley};
+use crate::tanpura::contact::{potential_density, HuntCrossley};
 
 /// One barrier: its points, shape, contact law and per-step work arrays.
 #[derive(Debug, Clone)]
