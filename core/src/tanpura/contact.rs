@@ -24,12 +24,15 @@
 //! Energy: `f̃ · s` splits into `−ξΦ` (the exact change of the scaled potential, so the lossless
 //! scheme conserves energy) and `ψΦs ≤ 0` (dissipation, since Φ and s have opposite signs).
 
-/// One barrier's contact law in the scheme's scaled units.
+/// One barrier's contact law: `f̃(s) = −ξ Φ(s)/s + ψ Φ(s)`. In the FD scheme's scaled units
+/// ([`HuntCrossley::scaled`]) or in newtons for a modal contact point
+/// ([`HuntCrossley::for_point`]); the force is linear in ξ and ψ, so one evaluation serves both.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HuntCrossley {
-    /// ξ = kΔt²/(4ρA), dimensionless per unit gap (k in N/m², Δt in s, ρA in kg/m).
+    /// Scaled: ξ = kΔt²/(4ρA), dimensionless per unit gap (k in N/m², Δt in s, ρA in kg/m).
+    /// Per point: ξ = w k/2, N/m.
     pub xi: f64,
-    /// ψ = k r Δt/(4ρA), per metre (r in s/m).
+    /// Scaled: ψ = k r Δt/(4ρA), per metre (r in s/m). Per point: ψ = w k r/(2Δt), N/m².
     pub psi: f64,
 }
 
@@ -56,6 +59,22 @@ impl HuntCrossley {
         let xi = stiffness_n_m2 * time_step_s * time_step_s / (4.0 * linear_density_kg_m);
         let psi = stiffness_n_m2 * damping_s_m * time_step_s / (4.0 * linear_density_kg_m);
         Self { xi, psi }
+    }
+
+    /// The same law for one contact point of a modal tier that stands for a length `length_m` of
+    /// its barrier, in newtons: `ξ = w k/2`, `ψ = w k r/(2Δt)`, so that the force is the point's
+    /// whole mid-point force `F = w f` (eq. 4), and its derivative `−∂F/∂s` in N/m.
+    pub fn for_point(
+        stiffness_n_m2: f64,
+        damping_s_m: f64,
+        length_m: f64,
+        time_step_s: f64,
+    ) -> Self {
+        let spring = stiffness_n_m2 * length_m;
+        Self {
+            xi: 0.5 * spring,
+            psi: 0.5 * spring * damping_s_m / time_step_s,
+        }
     }
 
     /// The mid-point force for gap `a` (before the step, metres, positive = penetrating) and
@@ -98,6 +117,56 @@ impl HuntCrossley {
                 squared_gap_change: 0.0,
             }
         }
+    }
+
+    /// The mid-point force with the damping taken linearly implicit, as the modal tiers use it:
+    /// the conservative part is the seed's discrete gradient `−ξ Φ(s)/s` (eq. 4), the damping
+    /// `−2ψ ⌊a⌋ s` uses the penetration before the step instead of the mid-point one (the seed's
+    /// `ψ Φ(s) = −ψ (2a − s) s` while in contact; they differ by `ψ s²`, second order in Δt, in a
+    /// term that is itself a fraction `r v` ≈ 0.5 % of the force). Its work `−2ψ⌊a⌋s²` is never
+    /// positive, so the scheme stays dissipative; and while the point stays in contact (or out)
+    /// the force is *linear* in s, so a step in which no point changes its contact case is solved
+    /// exactly by one Newton update. `squared_gap_change` is Φ as before, for the energy.
+    #[inline]
+    pub fn midpoint_force_linear_damping(&self, gap: f64, step: f64) -> ContactForce {
+        let gap_after = gap - step;
+        let damping = 2.0 * self.psi * gap.max(0.0);
+        if gap > 0.0 && gap_after > 0.0 {
+            ContactForce {
+                force: self.xi * (2.0 * gap - step) - damping * step,
+                stiffness: self.xi + damping,
+                squared_gap_change: gap_after * gap_after - gap * gap,
+            }
+        } else if gap > 0.0 {
+            // Leaves contact (s ≥ a > 0): Φ/s = −a²/s, d(Φ/s)/ds = a²/s².
+            let squared_gap_change = -gap * gap;
+            ContactForce {
+                force: -self.xi * squared_gap_change / step - damping * step,
+                stiffness: self.xi * (gap / step) * (gap / step) + damping,
+                squared_gap_change,
+            }
+        } else if gap_after > 0.0 {
+            // Enters contact (s < a ≤ 0): Φ/s = (a − s)²/s, no damping (a ≤ 0).
+            let squared_gap_change = gap_after * gap_after;
+            ContactForce {
+                force: -self.xi * squared_gap_change / step,
+                stiffness: -self.xi * gap_after * (gap + step) / (step * step),
+                squared_gap_change,
+            }
+        } else {
+            ContactForce {
+                force: 0.0,
+                stiffness: 0.0,
+                squared_gap_change: 0.0,
+            }
+        }
+    }
+
+    /// The energy the linearly implicit damping dissipates over a step `s` from gap `a`, in the
+    /// law's units times metres: `2ψ ⌊a⌋ s² ≥ 0`.
+    #[inline]
+    pub fn linear_damping_loss(&self, gap: f64, step: f64) -> f64 {
+        2.0 * self.psi * gap.max(0.0) * step * step
     }
 }
 
@@ -192,6 +261,37 @@ mod tests {
                 "{gap} {step}"
             );
         }
+    }
+
+    #[test]
+    fn linear_damping_keeps_the_conservative_part_and_dissipates() {
+        for &(gap, step) in &[(2e-5, 1e-5), (2e-5, 3e-5), (-1e-5, -3e-5), (1e-5, -2e-5)] {
+            let seed = LAW.midpoint_force(gap, step);
+            let linear = LAW.midpoint_force_linear_damping(gap, step);
+            // Same conservative part: the work splits into −ξΦ and a dissipation ≤ 0.
+            let conservative = -LAW.xi * linear.squared_gap_change;
+            let dissipation = linear.force * step - conservative;
+            assert!(dissipation <= 0.0);
+            assert!(
+                (dissipation + LAW.linear_damping_loss(gap, step)).abs() < 1e-22,
+                "{gap} {step}"
+            );
+            assert_eq!(seed.squared_gap_change, linear.squared_gap_change);
+            // The Jacobian entry is −∂F/∂s, and ≥ 0.
+            let h = 1e-12;
+            let numerical = -(LAW.midpoint_force_linear_damping(gap, step + h).force
+                - LAW.midpoint_force_linear_damping(gap, step - h).force)
+                / (2.0 * h);
+            assert!(linear.stiffness >= 0.0);
+            assert!((numerical - linear.stiffness).abs() <= 1e-5 * linear.stiffness.max(1.0));
+        }
+        // In contact the force is linear in s.
+        let (a, b, c) = (
+            LAW.midpoint_force_linear_damping(3e-5, 0.0).force,
+            LAW.midpoint_force_linear_damping(3e-5, 1e-5).force,
+            LAW.midpoint_force_linear_damping(3e-5, 2e-5).force,
+        );
+        assert!((a - 2.0 * b + c).abs() < 1e-15 * a.abs());
     }
 
     #[test]

@@ -21,6 +21,7 @@ pub mod excitation;
 pub mod fd;
 pub mod geometry;
 pub mod instrument;
+pub mod modal;
 pub mod quality;
 pub mod string;
 pub mod voice;

@@ -1,0 +1,546 @@
+//! The three loops over the modes, as SIMD kernels dispatched at run time.
+//!
+//! The modal step (`docs/modal-tanpura.md`, eq. M1) spends its time in three passes over the
+//! contiguous mode arrays: the free step `s = a p − b r`, the free motion of the contact points
+//! `Δu_i = Ψ_i · s` (one dot product per point), and the update that adds the contact forces,
+//! advances the state and forms the nut force. Each pass is a [`pulp::WithSimd`] kernel:
+//! [`pulp::Arch`] picks AVX-512, AVX2+FMA or scalar code once per process from the CPU, so the one
+//! generic x86-64 binary runs the widest unit the machine has (pulp comes with faer, so it adds
+//! nothing to the build). The kernels are generic over [`Real`] (f32 for the fast tier, f64 for
+//! the plain reference path); every array is padded to a multiple of [`LANE_PADDING`] elements
+//! with zeros, so no kernel has a tail on any instruction set.
+//!
+//! Hand-written rather than a linear-algebra crate: the vectors are about a hundred long, the
+//! calls happen once per sample on the audio thread, and a BLAS call would cost more in dispatch
+//! and bounds checks than the arithmetic (and some allocate). The dot products keep eight
+//! independent accumulators so that the multiply-add latency is hidden.
+//!
+//! Determinism: the same machine always takes the same path and the same summation order, so a
+//! render is bit-identical run to run; two machines with different vector units may differ at
+//! round-off.
+
+use pulp::{Arch, Simd, WithSimd};
+use std::fmt::Debug;
+
+/// Mode arrays are padded to a multiple of this many elements: two registers of 16 f32 lanes
+/// (AVX-512), so that every kernel sees whole register pairs on every instruction set.
+pub const LANE_PADDING: usize = 32;
+
+/// A floating-point type the mode kernels run in.
+pub trait Real: Copy + Default + Debug + PartialEq + Send + Sync + 'static {
+    /// The SIMD register of this type for the instruction set `S`.
+    type Lanes<S: Simd>: Copy;
+
+    fn from_f64(value: f64) -> Self;
+    fn to_f64(self) -> f64;
+    /// The slice as registers (its length is a multiple of [`LANE_PADDING`]).
+    fn lanes<S: Simd>(slice: &[Self]) -> &[Self::Lanes<S>];
+    fn lanes_mut<S: Simd>(slice: &mut [Self]) -> &mut [Self::Lanes<S>];
+    fn splat<S: Simd>(simd: S, value: Self) -> Self::Lanes<S>;
+    fn add<S: Simd>(simd: S, a: Self::Lanes<S>, b: Self::Lanes<S>) -> Self::Lanes<S>;
+    fn sub<S: Simd>(simd: S, a: Self::Lanes<S>, b: Self::Lanes<S>) -> Self::Lanes<S>;
+    fn mul<S: Simd>(simd: S, a: Self::Lanes<S>, b: Self::Lanes<S>) -> Self::Lanes<S>;
+    /// `a b + c`, fused where the unit has FMA.
+    fn mul_add<S: Simd>(
+        simd: S,
+        a: Self::Lanes<S>,
+        b: Self::Lanes<S>,
+        c: Self::Lanes<S>,
+    ) -> Self::Lanes<S>;
+    fn sum<S: Simd>(simd: S, a: Self::Lanes<S>) -> Self;
+}
+
+macro_rules! impl_real {
+    ($ty:ty, $lanes:ident, $as:ident, $as_mut:ident, $splat:ident, $add:ident, $sub:ident,
+     $mul:ident, $fma:ident, $sum:ident) => {
+        impl Real for $ty {
+            type Lanes<S: Simd> = S::$lanes;
+
+            #[inline(always)]
+            fn from_f64(value: f64) -> Self {
+                value as $ty
+            }
+            #[inline(always)]
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            #[inline(always)]
+            fn lanes<S: Simd>(slice: &[Self]) -> &[Self::Lanes<S>] {
+                let (lanes, tail) = S::$as(slice);
+                debug_assert!(tail.is_empty(), "mode arrays are padded to whole registers");
+                lanes
+            }
+            #[inline(always)]
+            fn lanes_mut<S: Simd>(slice: &mut [Self]) -> &mut [Self::Lanes<S>] {
+                let (lanes, tail) = S::$as_mut(slice);
+                debug_assert!(tail.is_empty(), "mode arrays are padded to whole registers");
+                lanes
+            }
+            #[inline(always)]
+            fn splat<S: Simd>(simd: S, value: Self) -> Self::Lanes<S> {
+                simd.$splat(value)
+            }
+            #[inline(always)]
+            fn add<S: Simd>(simd: S, a: Self::Lanes<S>, b: Self::Lanes<S>) -> Self::Lanes<S> {
+                simd.$add(a, b)
+            }
+            #[inline(always)]
+            fn sub<S: Simd>(simd: S, a: Self::Lanes<S>, b: Self::Lanes<S>) -> Self::Lanes<S> {
+                simd.$sub(a, b)
+            }
+            #[inline(always)]
+            fn mul<S: Simd>(simd: S, a: Self::Lanes<S>, b: Self::Lanes<S>) -> Self::Lanes<S> {
+                simd.$mul(a, b)
+            }
+            #[inline(always)]
+            fn mul_add<S: Simd>(
+                simd: S,
+                a: Self::Lanes<S>,
+                b: Self::Lanes<S>,
+                c: Self::Lanes<S>,
+            ) -> Self::Lanes<S> {
+                simd.$fma(a, b, c)
+            }
+            #[inline(always)]
+            fn sum<S: Simd>(simd: S, a: Self::Lanes<S>) -> Self {
+                simd.$sum(a)
+            }
+        }
+    };
+}
+
+impl_real!(
+    f32,
+    f32s,
+    as_simd_f32s,
+    as_mut_simd_f32s,
+    splat_f32s,
+    add_f32s,
+    sub_f32s,
+    mul_f32s,
+    mul_add_e_f32s,
+    reduce_sum_f32s
+);
+impl_real!(
+    f64,
+    f64s,
+    as_simd_f64s,
+    as_mut_simd_f64s,
+    splat_f64s,
+    add_f64s,
+    sub_f64s,
+    mul_f64s,
+    mul_add_e_f64s,
+    reduce_sum_f64s
+);
+
+/// The free step of every mode, `s = a p − b r` (eq. M1 without contact forces).
+struct FreeStep<'a, T: Real> {
+    a: &'a [T],
+    b: &'a [T],
+    r: &'a [T],
+    p: &'a [T],
+    s: &'a mut [T],
+}
+
+impl<T: Real> WithSimd for FreeStep<'_, T> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let (a, b) = (T::lanes::<S>(self.a), T::lanes::<S>(self.b));
+        let (r, p) = (T::lanes::<S>(self.r), T::lanes::<S>(self.p));
+        let modes = T::lanes_mut::<S>(self.s)
+            .iter_mut()
+            .zip(a.iter().zip(b))
+            .zip(r.iter().zip(p));
+        for ((s, (a, b)), (r, p)) in modes {
+            *s = T::sub(simd, T::mul(simd, *a, *p), T::mul(simd, *b, *r));
+        }
+    }
+}
+
+/// The motion of every point from a mode-major copy of the shapes:
+/// `out = Σ_k s_k Ψ_{·,k}`, one register row of points per mode (no horizontal sums).
+struct PointMotion<'a, T: Real> {
+    /// Ψᵀ: `modes × stride` (points padded to whole register pairs).
+    transposed: &'a [T],
+    stride: usize,
+    s: &'a [T],
+    out: &'a mut [T],
+}
+
+impl<T: Real> WithSimd for PointMotion<'_, T> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let out = T::lanes_mut::<S>(self.out);
+        // The partial sums live in registers when their count is a constant.
+        match out.len() {
+            1 => point_motion_fixed::<T, S, 1>(simd, self.transposed, self.stride, self.s, out),
+            2 => point_motion_fixed::<T, S, 2>(simd, self.transposed, self.stride, self.s, out),
+            3 => point_motion_fixed::<T, S, 3>(simd, self.transposed, self.stride, self.s, out),
+            4 => point_motion_fixed::<T, S, 4>(simd, self.transposed, self.stride, self.s, out),
+            _ => {
+                let zero = T::splat(simd, T::default());
+                out.fill(zero);
+                for (step, row) in self.s.iter().zip(self.transposed.chunks_exact(self.stride)) {
+                    let step = T::splat(simd, *step);
+                    for (sum, shape) in out.iter_mut().zip(T::lanes::<S>(row)) {
+                        *sum = T::mul_add(simd, *shape, step, *sum);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// [`PointMotion`] for `R` registers of points: four modes at a time into four partial sums, so
+/// that the multiply-add chains are a quarter of the modes long.
+#[inline(always)]
+fn point_motion_fixed<T: Real, S: Simd, const R: usize>(
+    simd: S,
+    transposed: &[T],
+    stride: usize,
+    s: &[T],
+    out: &mut [T::Lanes<S>],
+) {
+    let zero = T::splat(simd, T::default());
+    let mut partial = [[zero; R]; 4];
+    let mut modes = s.chunks_exact(4);
+    let mut rows = transposed.chunks_exact(4 * stride);
+    for (steps, block) in (&mut modes).zip(&mut rows) {
+        for (j, (step, row)) in steps.iter().zip(block.chunks_exact(stride)).enumerate() {
+            let step = T::splat(simd, *step);
+            let row = T::lanes::<S>(&row[..stride]);
+            for r in 0..R {
+                partial[j][r] = T::mul_add(simd, row[r], step, partial[j][r]);
+            }
+        }
+    }
+    for (step, row) in modes
+        .remainder()
+        .iter()
+        .zip(rows.remainder().chunks_exact(stride))
+    {
+        let step = T::splat(simd, *step);
+        let row = T::lanes::<S>(row);
+        for r in 0..R {
+            partial[0][r] = T::mul_add(simd, row[r], step, partial[0][r]);
+        }
+    }
+    for (r, value) in out.iter_mut().enumerate().take(R) {
+        *value = T::add(
+            simd,
+            T::add(simd, partial[0][r], partial[1][r]),
+            T::add(simd, partial[2][r], partial[3][r]),
+        );
+    }
+}
+
+/// Dot products of several rows of a matrix with one vector: `out[j] = matrix[rows[j]] · x`.
+struct Dots<'a, T: Real> {
+    matrix: &'a [T],
+    stride: usize,
+    rows: &'a [usize],
+    x: &'a [T],
+    out: &'a mut [f64],
+}
+
+impl<T: Real> WithSimd for Dots<'_, T> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let length = self.x.len();
+        let x = T::lanes::<S>(self.x);
+        let row = |index: usize| {
+            let start = index * self.stride;
+            T::lanes::<S>(&self.matrix[start..start + length])
+        };
+        let zero = T::splat(simd, T::default());
+        // Four rows per pass, two accumulators each (even and odd registers): eight independent
+        // multiply-add chains hide the latency, and each load of x serves four rows. The rows
+        // are zipped with x, so no access needs a bounds check.
+        let mut rows = self.rows.chunks_exact(4);
+        let mut outputs = self.out.chunks_exact_mut(4);
+        for (indices, out) in (&mut rows).zip(&mut outputs) {
+            let (r0, r1, r2, r3) = (
+                row(indices[0]),
+                row(indices[1]),
+                row(indices[2]),
+                row(indices[3]),
+            );
+            let mut even = [zero; 4];
+            let mut odd = [zero; 4];
+            let pairs = x
+                .chunks_exact(2)
+                .zip(r0.chunks_exact(2))
+                .zip(r1.chunks_exact(2))
+                .zip(r2.chunks_exact(2))
+                .zip(r3.chunks_exact(2));
+            for ((((xk, a), b), c), d) in pairs {
+                even[0] = T::mul_add(simd, a[0], xk[0], even[0]);
+                even[1] = T::mul_add(simd, b[0], xk[0], even[1]);
+                even[2] = T::mul_add(simd, c[0], xk[0], even[2]);
+                even[3] = T::mul_add(simd, d[0], xk[0], even[3]);
+                odd[0] = T::mul_add(simd, a[1], xk[1], odd[0]);
+                odd[1] = T::mul_add(simd, b[1], xk[1], odd[1]);
+                odd[2] = T::mul_add(simd, c[1], xk[1], odd[2]);
+                odd[3] = T::mul_add(simd, d[1], xk[1], odd[3]);
+            }
+            for j in 0..4 {
+                out[j] = T::sum(simd, T::add(simd, even[j], odd[j])).to_f64();
+            }
+        }
+        for (&index, out) in rows.remainder().iter().zip(outputs.into_remainder()) {
+            let mut sums = [zero; 2];
+            for (xk, a) in x.chunks_exact(2).zip(row(index).chunks_exact(2)) {
+                sums[0] = T::mul_add(simd, a[0], xk[0], sums[0]);
+                sums[1] = T::mul_add(simd, a[1], xk[1], sums[1]);
+            }
+            *out = T::sum(simd, T::add(simd, sums[0], sums[1])).to_f64();
+        }
+    }
+}
+
+/// Adds the contact forces to the free step and advances the state (eq. M1):
+/// `s += b Σ_j ΔF_j Ψ_j`, `r += s`, `p = s − p`; returns the nut force `c · r` after the step.
+struct Advance<'a, T: Real> {
+    b: &'a [T],
+    c: &'a [T],
+    matrix: &'a [T],
+    stride: usize,
+    rows: &'a [usize],
+    forces: &'a [T],
+    modal_force: &'a mut [T],
+    s: &'a mut [T],
+    r: &'a mut [T],
+    p: &'a mut [T],
+}
+
+impl<T: Real> WithSimd for Advance<'_, T> {
+    type Output = f64;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> f64 {
+        let zero = T::splat(simd, T::default());
+        let length = self.s.len();
+        // Σ_j ΔF_j Ψ_j, one contiguous row at a time.
+        let modal_force = T::lanes_mut::<S>(self.modal_force);
+        modal_force.fill(zero);
+        for (&row, force) in self.rows.iter().zip(self.forces) {
+            let force = T::splat(simd, *force);
+            let start = row * self.stride;
+            let shape = T::lanes::<S>(&self.matrix[start..start + length]);
+            for (sum, shape) in modal_force.iter_mut().zip(shape) {
+                *sum = T::mul_add(simd, *shape, force, *sum);
+            }
+        }
+        let b = T::lanes::<S>(self.b);
+        let c = T::lanes::<S>(self.c);
+        let s = T::lanes_mut::<S>(self.s);
+        let r = T::lanes_mut::<S>(self.r);
+        let p = T::lanes_mut::<S>(self.p);
+        // The nut force over two accumulators (the arrays are whole register pairs).
+        let mut nut = [zero; 2];
+        let modes = s
+            .chunks_exact_mut(2)
+            .zip(r.chunks_exact_mut(2))
+            .zip(p.chunks_exact_mut(2))
+            .zip(b.chunks_exact(2).zip(c.chunks_exact(2)))
+            .zip(modal_force.chunks_exact(2));
+        for ((((s, r), p), (b, c)), force) in modes {
+            for j in 0..2 {
+                let step = T::mul_add(simd, b[j], force[j], s[j]);
+                s[j] = step;
+                r[j] = T::add(simd, r[j], step);
+                p[j] = T::sub(simd, step, p[j]);
+                nut[j] = T::mul_add(simd, c[j], r[j], nut[j]);
+            }
+        }
+        T::sum(simd, T::add(simd, nut[0], nut[1])).to_f64()
+    }
+}
+
+/// The run-time selected vector unit and the kernels on it.
+#[derive(Debug, Clone, Copy)]
+pub struct Kernels {
+    arch: Arch,
+}
+
+impl Default for Kernels {
+    fn default() -> Self {
+        Self::detect()
+    }
+}
+
+impl Kernels {
+    /// The widest vector unit of this CPU.
+    pub fn detect() -> Self {
+        Self { arch: Arch::new() }
+    }
+
+    /// The vector unit in use, for reports ("AVX-512", "AVX2+FMA" or "scalar").
+    pub fn name(&self) -> &'static str {
+        match self.arch {
+            #[cfg(target_arch = "x86_64")]
+            Arch::V4(_) => "AVX-512",
+            #[cfg(target_arch = "x86_64")]
+            Arch::V3(_) => "AVX2+FMA",
+            _ => "scalar",
+        }
+    }
+
+    /// `s = a p − b r`.
+    pub fn free_step<T: Real>(&self, a: &[T], b: &[T], r: &[T], p: &[T], s: &mut [T]) {
+        self.arch.dispatch(FreeStep { a, b, r, p, s });
+    }
+
+    /// `out = Σ_k s_k transposed[k]`: the motion of every point, with the shapes stored
+    /// mode-major (`transposed[k * stride + i] = Ψ_ik`; `out.len() ≤ stride`, whole registers).
+    pub fn point_motion<T: Real>(&self, transposed: &[T], stride: usize, s: &[T], out: &mut [T]) {
+        self.arch.dispatch(PointMotion {
+            transposed,
+            stride,
+            s,
+            out,
+        });
+    }
+
+    /// `out[j] = matrix[rows[j]] · x` for every listed row of the row-major `matrix` whose rows
+    /// start `stride` elements apart (`x.len() ≤ stride`).
+    pub fn dots<T: Real>(
+        &self,
+        matrix: &[T],
+        stride: usize,
+        rows: &[usize],
+        x: &[T],
+        out: &mut [f64],
+    ) {
+        debug_assert!(out.len() >= rows.len() && x.len() <= stride);
+        self.arch.dispatch(Dots {
+            matrix,
+            stride,
+            rows,
+            x,
+            out,
+        });
+    }
+
+    /// `s += b Σ_j forces_j matrix[rows_j]`, `r += s`, `p = s − p`; returns `c · r`.
+    /// `modal_force` is scratch of the arrays' length.
+    #[allow(clippy::too_many_arguments)]
+    pub fn advance<T: Real>(
+        &self,
+        b: &[T],
+        c: &[T],
+        matrix: &[T],
+        stride: usize,
+        rows: &[usize],
+        forces: &[T],
+        modal_force: &mut [T],
+        s: &mut [T],
+        r: &mut [T],
+        p: &mut [T],
+    ) -> f64 {
+        self.arch.dispatch(Advance {
+            b,
+            c,
+            matrix,
+            stride,
+            rows,
+            forces,
+            modal_force,
+            s,
+            r,
+            p,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn padded(values: impl Iterator<Item = f64>, length: usize) -> Vec<f64> {
+        let mut v: Vec<f64> = values.take(length).collect();
+        v.resize(length, 0.0);
+        v
+    }
+
+    #[test]
+    fn kernels_equal_the_plain_loops() {
+        let kernels = Kernels::detect();
+        let n = 48;
+        let wave = |phase: f64| padded((0..).map(move |k| (k as f64 * 0.37 + phase).sin()), n);
+        let (a, b, r, p, c) = (wave(0.1), wave(0.7), wave(1.3), wave(2.1), wave(2.9));
+        let rows: Vec<Vec<f64>> = (0..11).map(|j| wave(0.5 * j as f64)).collect();
+        let matrix: Vec<f64> = rows.concat();
+        let all: Vec<usize> = (0..rows.len()).collect();
+
+        let mut s = vec![0.0; n];
+        kernels.free_step(&a, &b, &r, &p, &mut s);
+        for k in 0..n {
+            assert!((s[k] - (a[k] * p[k] - b[k] * r[k])).abs() < 1e-15);
+        }
+        // The same motions from the mode-major copy.
+        let stride = 32;
+        let mut transposed = vec![0.0; n * stride];
+        for (j, row) in rows.iter().enumerate() {
+            for k in 0..n {
+                transposed[k * stride + j] = row[k];
+            }
+        }
+        let mut motion = vec![0.0; stride];
+        kernels.point_motion(&transposed, stride, &s, &mut motion);
+
+        let mut dots = vec![0.0; rows.len()];
+        kernels.dots(&matrix, n, &all, &s, &mut dots);
+        for (j, row) in rows.iter().enumerate() {
+            let plain: f64 = row.iter().zip(&s).map(|(x, y)| x * y).sum();
+            assert!((dots[j] - plain).abs() < 1e-13, "row {j}");
+            assert!((motion[j] - plain).abs() < 1e-13, "row {j}");
+        }
+        assert!(motion[rows.len()..].iter().all(|&v| v == 0.0));
+
+        let forces = [0.3, -1.2, 0.05];
+        let (mut s2, mut r2, mut p2) = (s.clone(), r.clone(), p.clone());
+        let mut scratch = vec![0.0; n];
+        let nut = kernels.advance(
+            &b,
+            &c,
+            &matrix,
+            n,
+            &[0, 1, 2],
+            &forces,
+            &mut scratch,
+            &mut s2,
+            &mut r2,
+            &mut p2,
+        );
+        let mut plain_nut = 0.0;
+        for k in 0..n {
+            let modal: f64 = (0..3).map(|j| forces[j] * rows[j][k]).sum();
+            let step = s[k] + b[k] * modal;
+            assert!((s2[k] - step).abs() < 1e-14);
+            assert!((r2[k] - (r[k] + step)).abs() < 1e-14);
+            assert!((p2[k] - (step - p[k])).abs() < 1e-14);
+            plain_nut += c[k] * (r[k] + step);
+        }
+        assert!((nut - plain_nut).abs() < 1e-13);
+    }
+
+    #[test]
+    fn single_precision_kernels_agree_to_single_precision() {
+        let kernels = Kernels::detect();
+        let n = 32;
+        let x: Vec<f32> = (0..n).map(|k| (k as f32 * 0.3).cos()).collect();
+        let row: Vec<f32> = (0..n).map(|k| (k as f32 * 0.11).sin()).collect();
+        let mut out = [0.0];
+        kernels.dots(&row, n, &[0], &x, &mut out);
+        let plain: f64 = x.iter().zip(&row).map(|(a, b)| *a as f64 * *b as f64).sum();
+        assert!((out[0] - plain).abs() < 1e-5);
+    }
+}

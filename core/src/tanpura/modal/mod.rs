@@ -1,0 +1,822 @@
+//! The modal discretisation of the tanpura string: the discretisation of the fast tiers.
+//!
+//! Derived in `docs/modal-tanpura.md`; the equation labels below are that document's. The same
+//! continuous model as the seed's FD scheme (seed 000, eq. 5–9, `shared/notes/tanpura-model.md`)
+//! and the same bridge and thread profiles (`geometry.rs`), discretised differently:
+//!
+//! - `modes.rs`: the string's eigenmodes with the lowered support (section 1), each advanced by an
+//!   exact two-pole recursion in mid-point form at the output rate (eq. M1–M2): exact partial
+//!   frequencies and decay rates σ = γ/2 + ηω²/2 at any sample rate, no oversampling, no
+//!   dispersion, no decimator. Modes below min(20 kHz, 0.45 f_s) are kept.
+//! - `points.rs`: the bridge and thread as a few contact points, coupled to the modes through the
+//!   mode shapes there, with the seed's mid-point Hunt–Crossley force (eq. 4, `contact.rs`).
+//! - `solve.rs`: Newton's method on the points that touch (section 4), the static problems of
+//!   the rest state and the pluck, and the linearised fundamental the tuning uses (section 5).
+//! - `lanes.rs`: the three passes over the modes as SIMD kernels, dispatched at run time.
+//!
+//! Energy (eq. M3): `H = Σ_k [r_k²/2 + (a_k/2b_k) p_k²] + Σ_i V_i(a_i)` changes over a step by
+//! exactly minus the losses of the modes and of the contact damping, so the lossless scheme
+//! conserves H and the lossy one never increases it, for any step, any modes and any points. A
+//! pluck's work is booked as external work, as in the FD tiers.
+//!
+//! The state is carried as the deviation from the rest state (`r̃ = r − r_rest`, section 4), so a
+//! string at rest is an exact fixed point in any precision. `T` is the precision of the mode
+//! arrays (f32 for the fast tier, f64 for the plain reference path); the contact solves and all
+//! static problems run in f64.
+
+pub mod lanes;
+pub mod modes;
+pub mod points;
+pub mod solve;
+
+use crate::newton::{NewtonSettings, NewtonStats};
+use crate::tanpura::excitation::{finger_height_m, Pluck};
+use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
+use crate::tanpura::string::StringParameters;
+use lanes::{Kernels, Real, LANE_PADDING};
+use modes::{ModeSet, AUDIBLE_LIMIT_HZ, MODE_CAPACITY};
+use points::{grid_points, ContactPoints};
+use solve::{linearised_fundamental, ContactStep, StaticSolver};
+use std::f64::consts::PI;
+
+const _: () = assert!(MODE_CAPACITY % LANE_PADDING == 0);
+
+/// Largest fingertip the finger's points have room for, m.
+const MAX_FINGER_WIDTH_M: f64 = 0.040;
+/// Inverse iterations for the linearised fundamental (the error falls by (f₁/f₂)² ≈ 1/4 each).
+const TUNING_ITERATIONS: usize = 30;
+/// Points whose gap lies within this distance of contact are tracked: Newton iterates on them.
+/// Every other point's step follows from the converged forces, and a point that would touch joins
+/// before the step is taken (`ModalString::step`), so the band is only a matter of cost.
+pub const TRACKING_BAND_M: f64 = 20e-6;
+/// The points' motion vector is padded to a multiple of this (one AVX-512 register of f32).
+const POINT_PADDING: usize = 16;
+
+/// Everything that defines one modal string.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModalStringConfig {
+    pub string: StringParameters,
+    /// Δt, s: the output rate's sample period.
+    pub time_step_s: f64,
+    /// The bridge profile and law; its contact points cover `start_m..end_m`.
+    pub bridge: BridgeSettings,
+    /// `None`: no thread.
+    pub thread: Option<ThreadSettings>,
+    pub finger: FingerSettings,
+    /// Modes are kept below this frequency (and below 0.45 of the sample rate), Hz.
+    pub highest_mode_hz: f64,
+    /// Spacing of the contact points on the bridge and on the thread, m.
+    pub bridge_point_spacing_m: f64,
+    pub thread_point_spacing_m: f64,
+    pub newton: NewtonSettings,
+    /// Book the losses of every step (tests and research tools; costs a pass over the modes).
+    pub track_energy: bool,
+}
+
+impl ModalStringConfig {
+    /// The seed's string, bridge and thread at 44.1 kHz, modes up to 20 kHz, contact points
+    /// every millimetre on the bridge and every half millimetre on the thread.
+    pub const REFERENCE: ModalStringConfig = ModalStringConfig {
+        string: StringParameters::SEED,
+        time_step_s: 1.0 / 44_100.0,
+        bridge: BridgeSettings::SEED,
+        thread: Some(ThreadSettings::SEED),
+        finger: FingerSettings::SEED,
+        highest_mode_hz: AUDIBLE_LIMIT_HZ,
+        bridge_point_spacing_m: 1e-3,
+        thread_point_spacing_m: 0.5e-3,
+        newton: NewtonSettings {
+            tolerance_m: 1e-12,
+            max_iterations: 30,
+        },
+        track_energy: false,
+    };
+
+    /// The same with all losses off (γ = η = r_b = r_c = 0).
+    pub fn lossless(mut self) -> Self {
+        self.string.gamma_per_s = 0.0;
+        self.string.eta_s = 0.0;
+        self.bridge.damping_s_m = 0.0;
+        if let Some(thread) = &mut self.thread {
+            thread.damping_s_m = 0.0;
+        }
+        self
+    }
+
+    /// Where the speaking length starts: the thread if present, else the bridge crest.
+    pub fn speaking_start_m(&self) -> f64 {
+        match self.thread {
+            Some(thread) => thread.position_m,
+            None => self.bridge.crest_position_m,
+        }
+    }
+
+    /// Where the bridge's points start: just before the first place the string can reach the
+    /// bridge. With a thread that is the thread; without one, the string comes from the lowered
+    /// support with the slope `|y_TB|/x_crest` and first meets the parabola where the bridge's
+    /// slope equals it, `R_b |y_TB|/x_crest` before the crest. Two millimetres more for margin.
+    /// On the bead's side of that the string runs above the bridge (0.5–1 mm at rest), so the
+    /// FD grids' points there never carry a force.
+    fn bridge_start_m(&self) -> f64 {
+        let crest = self.bridge.crest_position_m;
+        let first_touch =
+            crest - self.bridge.curvature_radius_m * self.string.left_support_m.abs() / crest;
+        let speaking = self.thread.map_or(first_touch, |thread| {
+            thread.position_m - thread.half_width_m()
+        });
+        (speaking.min(first_touch) - 2e-3).max(self.bridge.start_m)
+    }
+
+    /// Where the bridge's points end: the bridge's end, or the thread without the bridge beyond it.
+    fn bridge_end_m(&self) -> f64 {
+        match (self.bridge.beyond_thread, self.thread) {
+            (false, Some(thread)) => self.bridge.end_m.min(thread.position_m),
+            _ => self.bridge.end_m,
+        }
+    }
+
+    fn point_capacity(&self) -> usize {
+        // The earliest start over the thread's range of positions.
+        let earliest = ModalStringConfig {
+            thread: Some(ThreadSettings {
+                position_m: ThreadSettings::POSITION_RANGE_M.0,
+                ..ThreadSettings::SEED
+            }),
+            ..*self
+        }
+        .bridge_start_m()
+        .min(self.bridge_start_m());
+        let bridge = grid_points(earliest, self.bridge.end_m, self.bridge_point_spacing_m);
+        let half_width = ThreadSettings::SEED
+            .half_width_m()
+            .max(self.thread.map_or(0.0, |thread| thread.half_width_m()));
+        let thread = 2 * (half_width / self.thread_point_spacing_m).floor() as usize + 1;
+        bridge + thread
+    }
+}
+
+impl Default for ModalStringConfig {
+    fn default() -> Self {
+        Self::REFERENCE
+    }
+}
+
+/// One tanpura string in modal form; allocation-free after [`ModalString::new`].
+#[derive(Debug, Clone)]
+pub struct ModalString<T: Real> {
+    config: ModalStringConfig,
+    modes: ModeSet,
+    kernels: Kernels,
+    /// The kept modes rounded up to whole registers: the length the kernels run over.
+    lanes: usize,
+    // The mode arrays the kernels run on (T), MODE_CAPACITY long, zero beyond the kept modes.
+    a: Vec<T>,
+    b: Vec<T>,
+    nut_weights: Vec<T>,
+    /// r̃ = r − r_rest.
+    modal: Vec<T>,
+    /// p, the scaled velocity of eq. M1.
+    velocity: Vec<T>,
+    /// s, the step (free step, then the whole step).
+    step: Vec<T>,
+    modal_force: Vec<T>,
+    /// Ψ rows in T, `points.capacity() × MODE_CAPACITY` (the force projection).
+    shapes: Vec<T>,
+    /// Ψ mode-major in T, `MODE_CAPACITY × point_stride` (the points' free motion).
+    transposed_shapes: Vec<T>,
+    point_stride: usize,
+    point_motion: Vec<T>,
+    points: ContactPoints,
+    contact: ContactStep,
+    solver: StaticSolver,
+    loaded_forces: Vec<T>,
+    /// r_rest (f64) and a scratch row.
+    rest_modal: Vec<f64>,
+    row: Vec<f64>,
+    stats: NewtonStats,
+    nut_force_change_n: f64,
+    bridge_force_change_n: f64,
+    rest_nut_force_n: f64,
+    rest_bridge_force_n: f64,
+    max_penetration_m: f64,
+    cumulative_losses_j: f64,
+    external_work_j: f64,
+    static_solve_failures: u64,
+    non_finite_resets: u64,
+}
+
+impl<T: Real> ModalString<T> {
+    /// Builds the string and settles it at rest on bridge and thread. Allocates.
+    pub fn new(config: ModalStringConfig) -> Self {
+        let points = config.point_capacity();
+        let stride = points.div_ceil(POINT_PADDING) * POINT_PADDING;
+        let finger = grid_points(0.0, MAX_FINGER_WIDTH_M, config.finger.spacing_m);
+        let mut string = Self {
+            config,
+            modes: ModeSet::new(),
+            kernels: Kernels::detect(),
+            lanes: 0,
+            a: vec![T::default(); MODE_CAPACITY],
+            b: vec![T::default(); MODE_CAPACITY],
+            nut_weights: vec![T::default(); MODE_CAPACITY],
+            modal: vec![T::default(); MODE_CAPACITY],
+            velocity: vec![T::default(); MODE_CAPACITY],
+            step: vec![T::default(); MODE_CAPACITY],
+            modal_force: vec![T::default(); MODE_CAPACITY],
+            shapes: vec![T::default(); points * MODE_CAPACITY],
+            transposed_shapes: vec![T::default(); MODE_CAPACITY * stride],
+            point_stride: stride,
+            point_motion: vec![T::default(); stride],
+            points: ContactPoints::with_capacity(points),
+            contact: ContactStep::new(points),
+            solver: StaticSolver::new(points + finger),
+            loaded_forces: vec![T::default(); points],
+            rest_modal: vec![0.0; MODE_CAPACITY],
+            row: vec![0.0; MODE_CAPACITY],
+            stats: NewtonStats::default(),
+            nut_force_change_n: 0.0,
+            bridge_force_change_n: 0.0,
+            rest_nut_force_n: 0.0,
+            rest_bridge_force_n: 0.0,
+            max_penetration_m: 0.0,
+            cumulative_losses_j: 0.0,
+            external_work_j: 0.0,
+            static_solve_failures: 0,
+            non_finite_resets: 0,
+        };
+        string.apply_config();
+        string.reset();
+        string
+    }
+
+    /// Changes the configuration without reallocating; the string keeps its motion (its modal
+    /// displacement and velocity) about the new rest state. Returns false, changing nothing,
+    /// when the new configuration needs more contact points than the string was built for.
+    pub fn set_config(&mut self, config: ModalStringConfig) -> bool {
+        if config.point_capacity() > self.points.capacity()
+            || !(config.time_step_s > 0.0)
+            || config.string.length_m != self.config.string.length_m
+        {
+            return false;
+        }
+        if config == self.config {
+            return true;
+        }
+        // The motion in physical modal coordinates: q = r/√κ, q̇ ∝ p/√κ.
+        let old_count = self.modes.count();
+        for k in 0..MODE_CAPACITY {
+            let scale = if k < old_count {
+                self.modes.inverse_root_stiffness[k]
+            } else {
+                0.0
+            };
+            self.row[k] = (self.modal[k].to_f64() + self.rest_modal[k]) * scale;
+            self.modal_force[k] = T::from_f64(self.velocity[k].to_f64() * scale);
+        }
+        self.config = config;
+        self.apply_config();
+        self.update_rest_state();
+        let count = self.modes.count();
+        for k in 0..MODE_CAPACITY {
+            let root = if k < count {
+                self.modes.stiffness[k].sqrt()
+            } else {
+                0.0
+            };
+            self.modal[k] = T::from_f64(self.row[k] * root - self.rest_modal[k]);
+            self.velocity[k] = T::from_f64(self.modal_force[k].to_f64() * root);
+        }
+        self.contact.corrections_m.fill(0.0);
+        self.refresh_gaps();
+        true
+    }
+
+    fn apply_config(&mut self) {
+        let config = self.config;
+        self.modes
+            .configure(&config.string, config.time_step_s, config.highest_mode_hz);
+        self.points.place(
+            &config.bridge,
+            config.bridge_start_m(),
+            config.bridge_end_m(),
+            config.bridge_point_spacing_m,
+            config.thread.as_ref(),
+            config.thread_point_spacing_m,
+            config.time_step_s,
+            config.string.left_support_m,
+            config.string.length_m,
+        );
+        self.points.couple(&self.modes);
+        self.contact.coupling_changed();
+        self.lanes = self.modes.count().div_ceil(LANE_PADDING) * LANE_PADDING;
+        for k in 0..MODE_CAPACITY {
+            self.a[k] = T::from_f64(self.modes.a[k]);
+            self.b[k] = T::from_f64(self.modes.b[k]);
+            self.nut_weights[k] = T::from_f64(self.modes.nut_weight[k]);
+        }
+        for (target, source) in self.shapes.iter_mut().zip(&self.points.shapes) {
+            *target = T::from_f64(*source);
+        }
+        self.transposed_shapes.fill(T::default());
+        for i in 0..self.points.len() {
+            for (k, value) in self.points.shape(i).iter().enumerate() {
+                self.transposed_shapes[k * self.point_stride + i] = T::from_f64(*value);
+            }
+        }
+    }
+
+    /// Puts the string at rest on bridge and thread and clears every statistic and ledger.
+    pub fn reset(&mut self) {
+        self.update_rest_state();
+        self.settle_to_rest();
+        self.stats = NewtonStats::default();
+        self.cumulative_losses_j = 0.0;
+        self.external_work_j = 0.0;
+        self.static_solve_failures = 0;
+        self.non_finite_resets = 0;
+    }
+
+    /// The static equilibrium on bridge and thread (section 5), warm-started from the last one.
+    fn update_rest_state(&mut self) {
+        let count = self.solver.load_points(&self.points);
+        let modes = self.modes.count();
+        self.solver.forces_n[..count].copy_from_slice(&self.points.rest_forces_n[..count]);
+        if !self.solver.solve(count, modes) {
+            self.static_solve_failures += 1;
+        }
+        self.rest_modal.fill(0.0);
+        self.rest_modal[..modes].copy_from_slice(&self.solver.modal[..modes]);
+        for i in 0..count {
+            self.points.rest_forces_n[i] = self.solver.forces_n[i];
+            self.points.rest_gaps_m[i] =
+                self.points.free_gaps_m[i] - self.solver.displacements_m[i];
+        }
+        let string = &self.config.string;
+        self.rest_nut_force_n = string.tension_n * string.left_support_m / string.length_m
+            + (0..modes)
+                .map(|k| self.modes.nut_weight[k] * self.rest_modal[k])
+                .sum::<f64>();
+        self.rest_bridge_force_n = self.points.rest_forces_n[..count].iter().sum();
+    }
+
+    /// The gaps of every point for the current state: `a_i = a_rest,i − Ψ_i r̃`.
+    fn refresh_gaps(&mut self) {
+        let modes = self.modes.count();
+        for i in 0..self.points.len() {
+            let displacement: f64 = self.points.shape(i)[..modes]
+                .iter()
+                .zip(&self.modal[..modes])
+                .map(|(psi, r)| psi * r.to_f64())
+                .sum();
+            self.contact.gaps_m[i] = self.points.rest_gaps_m[i] - displacement;
+        }
+        self.contact.classify(&self.points, TRACKING_BAND_M);
+    }
+
+    /// Puts a decayed string exactly at rest (the sleeping state), keeping the ledgers.
+    pub fn settle_to_rest(&mut self) {
+        let energy_before = self.vibration_energy_j();
+        self.modal.fill(T::default());
+        self.velocity.fill(T::default());
+        self.step.fill(T::default());
+        let count = self.points.len();
+        self.contact.gaps_m[..count].copy_from_slice(&self.points.rest_gaps_m[..count]);
+        self.contact.corrections_m.fill(0.0);
+        self.contact.classify(&self.points, TRACKING_BAND_M);
+        self.external_work_j -= energy_before;
+        self.nut_force_change_n = 0.0;
+        self.bridge_force_change_n = 0.0;
+        self.max_penetration_m = 0.0;
+    }
+
+    /// Advances one sample (eq. M1 with Newton on the tracked points, section 4). Allocation-free;
+    /// never panics.
+    pub fn step(&mut self) {
+        // The kernels run over the kept modes, padded to whole registers.
+        let lanes = self.lanes;
+        self.kernels.free_step(
+            &self.a[..lanes],
+            &self.b[..lanes],
+            &self.modal[..lanes],
+            &self.velocity[..lanes],
+            &mut self.step[..lanes],
+        );
+        let count = self.points.len();
+        let padded = count.div_ceil(POINT_PADDING) * POINT_PADDING;
+        self.kernels.point_motion(
+            &self.transposed_shapes[..lanes * self.point_stride],
+            self.point_stride,
+            &self.step[..lanes],
+            &mut self.point_motion[..padded],
+        );
+        let contact = &mut self.contact;
+        for (free, motion) in contact.free_steps_m[..count]
+            .iter_mut()
+            .zip(&self.point_motion)
+        {
+            *free = motion.to_f64();
+        }
+        contact.gather(&self.points);
+        let mut iterations = 0;
+        let mut converged = true;
+        loop {
+            let contact = &mut self.contact;
+            if !contact.local.settle_if_free() {
+                let (updates, done) = contact.local.solve(&self.config.newton);
+                iterations += updates;
+                converged = done;
+                // The forces at the accepted step, for the update, the outputs and the ledger.
+                contact.local.evaluate();
+            }
+            contact.publish();
+            // Every other point: does it touch during this step? If so, it joins and the
+            // contact solve is redone before anything moves.
+            if !self.check_untracked_points() {
+                break;
+            }
+            self.contact.gather(&self.points);
+        }
+        self.stats.record(iterations, converged);
+
+        let contact = &mut self.contact;
+        let loaded = contact.loaded_count;
+        let mut bridge_change = 0.0;
+        for (value, change) in self.loaded_forces[..loaded]
+            .iter_mut()
+            .zip(&contact.force_changes_n[..loaded])
+        {
+            *value = T::from_f64(*change);
+            bridge_change += change;
+        }
+        let mut penetration = 0.0f64;
+        for i in 0..count {
+            contact.gaps_m[i] -= contact.steps_m[i];
+            penetration = penetration.max(contact.gaps_m[i]);
+        }
+        if self.config.track_energy {
+            // Contact damping at this step's forces; the modes' loss needs the whole step below.
+            self.cumulative_losses_j += contact.local.damping_loss_j();
+        }
+        let nut_change = self.kernels.advance(
+            &self.b[..lanes],
+            &self.nut_weights[..lanes],
+            &self.shapes,
+            MODE_CAPACITY,
+            &contact.loaded[..loaded],
+            &self.loaded_forces[..loaded],
+            &mut self.modal_force[..lanes],
+            &mut self.step[..lanes],
+            &mut self.modal[..lanes],
+            &mut self.velocity[..lanes],
+        );
+        if self.config.track_energy {
+            self.cumulative_losses_j += (0..self.modes.count())
+                .map(|k| {
+                    let s = self.step[k].to_f64();
+                    self.modes.loss_factor[k] * s * s
+                })
+                .sum::<f64>();
+        }
+        self.update_tracking();
+        self.nut_force_change_n = nut_change;
+        self.bridge_force_change_n = bridge_change;
+        self.max_penetration_m = penetration;
+        if !nut_change.is_finite() || !bridge_change.is_finite() {
+            // Fail soft: a non-finite state cannot recover, so silence the string at rest.
+            self.non_finite_resets += 1;
+            let external = self.external_work_j;
+            self.settle_to_rest();
+            self.external_work_j = external;
+        }
+    }
+
+    /// The step of every untracked point from the converged forces,
+    /// `Δu_i = Δu_free,i + Σ_j G_ij ΔF_j`: a point that would touch during this step joins the
+    /// tracked set now (returns true: the solve must be redone), one that comes within
+    /// [`TRACKING_BAND_M`] of contact joins after the step.
+    fn check_untracked_points(&mut self) -> bool {
+        let contact = &mut self.contact;
+        let points = &self.points;
+        let mut redo = false;
+        for i in 0..points.len() {
+            if contact.is_tracked[i] {
+                continue;
+            }
+            let mut step = contact.free_steps_m[i];
+            for (&j, change) in contact.loaded[..contact.loaded_count]
+                .iter()
+                .zip(&contact.force_changes_n)
+            {
+                step += points.coupling(i, j) * change;
+            }
+            contact.steps_m[i] = step;
+            if contact.gaps_m[i] - step > 0.0 {
+                contact.corrections_m[i] = step - contact.free_steps_m[i];
+                contact.track(i);
+                redo = true;
+            }
+        }
+        redo
+    }
+
+    /// After a step: untracked points that came within [`TRACKING_BAND_M`] of contact join the
+    /// tracked set; tracked points farther than twice that, with no force now or at rest, leave it.
+    fn update_tracking(&mut self) {
+        let contact = &mut self.contact;
+        let points = &self.points;
+        contact.release_far(points, 2.0 * TRACKING_BAND_M);
+        for i in 0..points.len() {
+            if !contact.is_tracked[i] && contact.gaps_m[i] > -TRACKING_BAND_M {
+                contact.corrections_m[i] = 0.0;
+                contact.track(i);
+            }
+        }
+    }
+
+    /// Forgets Newton's initial guess, so that a new excitation evolves exactly as it would on
+    /// a freshly built string.
+    fn forget_motion_history(&mut self) {
+        self.contact.corrections_m.fill(0.0);
+    }
+
+    /// The rest shape's displacement at `x_m`, m.
+    pub fn rest_displacement_at_m(&mut self, x_m: f64) -> f64 {
+        self.modes.shape_row(x_m, &mut self.row);
+        let line = self.config.string.left_support_m * (1.0 - x_m / self.config.string.length_m);
+        line + self
+            .row
+            .iter()
+            .zip(&self.rest_modal)
+            .map(|(psi, r)| psi * r)
+            .sum::<f64>()
+    }
+
+    /// The string's displacement at `x_m` now, m: `y_s(x) + Σ_k Ψ_k(x) (r_rest,k + r̃_k)`.
+    pub fn displacement_at_m(&mut self, x_m: f64) -> f64 {
+        self.modes.shape_row(x_m, &mut self.row);
+        let line = self.config.string.left_support_m * (1.0 - x_m / self.config.string.length_m);
+        line + (0..self.modes.count())
+            .map(|k| self.row[k] * (self.rest_modal[k] + self.modal[k].to_f64()))
+            .sum::<f64>()
+    }
+
+    /// The seed's finger pluck (section 5): press the finger until the string is in static
+    /// equilibrium against finger, bridge and thread, then release it. The previous motion is
+    /// stopped by the finger; the work done is booked as external work. Allocation-free.
+    pub fn pluck(&mut self, pluck: &Pluck) {
+        self.forget_motion_history();
+        let energy_before = self.energy_j();
+        let length = self.config.string.length_m;
+        let width = pluck.width_m.clamp(
+            Pluck::WIDTH_RANGE_M.0,
+            Pluck::WIDTH_RANGE_M.1.min(MAX_FINGER_WIDTH_M),
+        );
+        let amplitude = pluck
+            .amplitude_m
+            .clamp(Pluck::AMPLITUDE_RANGE_M.0, Pluck::AMPLITUDE_RANGE_M.1);
+        let half_width = 0.5 * width;
+        let lowest = self.config.speaking_start_m() + half_width + 1e-3;
+        let highest = length - half_width - 1e-3;
+        let centre = pluck.position_m.clamp(lowest, highest.max(lowest));
+        let top = self.rest_displacement_at_m(centre) + amplitude;
+
+        let count = self.solver.load_points(&self.points);
+        let spacing = self.config.finger.spacing_m;
+        let finger_points = grid_points(0.0, width, spacing).min(self.solver.capacity() - count);
+        let left = self.config.string.left_support_m;
+        for index in 0..finger_points {
+            let x = centre - half_width + index as f64 * spacing;
+            let row = count + index;
+            self.modes.shape_row(
+                x,
+                &mut self.solver.shapes[row * MODE_CAPACITY..(row + 1) * MODE_CAPACITY],
+            );
+            self.solver.free_gaps_m[row] =
+                finger_height_m(x, centre, width, top) - left * (1.0 - x / length);
+            self.solver.springs_n_m[row] = self.config.finger.stiffness_n_m2 * spacing;
+            self.solver.forces_n[row] = 0.0;
+        }
+        self.solver.forces_n[..count].copy_from_slice(&self.points.rest_forces_n[..count]);
+        let modes = self.modes.count();
+        if !self.solver.solve(count + finger_points, modes) {
+            self.static_solve_failures += 1;
+        }
+        for k in 0..MODE_CAPACITY {
+            let pressed = if k < modes { self.solver.modal[k] } else { 0.0 };
+            self.modal[k] = T::from_f64(pressed - self.rest_modal[k]);
+        }
+        self.velocity.fill(T::default());
+        self.refresh_gaps();
+        self.external_work_j += self.energy_j() - energy_before;
+        self.refresh_outputs_at_rest_of_motion();
+    }
+
+    /// The seed's "first mode" initial condition: the rest shape plus `amplitude_m` times the
+    /// first mode of the speaking length, released from rest. Allocation-free.
+    pub fn excite_first_mode(&mut self, amplitude_m: f64) {
+        self.forget_motion_history();
+        let energy_before = self.energy_j();
+        let start = self.config.speaking_start_m();
+        let length = self.config.string.length_m;
+        for k in 0..MODE_CAPACITY {
+            let value = if k < self.modes.count() {
+                // q_k = (2/L) ∫ A sin(π(x − x₀)/(L − x₀)) sin(β_k x) dx over the speaking length.
+                let projection = first_mode_projection(start, length, k + 1);
+                amplitude_m * projection * self.modes.stiffness[k].sqrt()
+            } else {
+                0.0
+            };
+            self.modal[k] = T::from_f64(value);
+        }
+        self.velocity.fill(T::default());
+        self.refresh_gaps();
+        self.external_work_j += self.energy_j() - energy_before;
+        self.refresh_outputs_at_rest_of_motion();
+    }
+
+    fn refresh_outputs_at_rest_of_motion(&mut self) {
+        let modes = self.modes.count();
+        self.nut_force_change_n = (0..modes)
+            .map(|k| self.modes.nut_weight[k] * self.modal[k].to_f64())
+            .sum();
+        self.bridge_force_change_n = (0..self.points.len())
+            .map(|i| {
+                self.points.springs_n_m[i] * self.contact.gaps_m[i].max(0.0)
+                    - self.points.rest_forces_n[i]
+            })
+            .sum();
+    }
+
+    /// The vibration energy above the rest state (section 4), J: non-negative, computed
+    /// without cancellation; what decides when a string may sleep.
+    pub fn vibration_energy_j(&self) -> f64 {
+        let modes: f64 = (0..self.modes.count())
+            .map(|k| {
+                let (r, p) = (self.modal[k].to_f64(), self.velocity[k].to_f64());
+                0.5 * r * r + self.modes.kinetic_factor[k] * p * p
+            })
+            .sum();
+        modes + self.points.excess_energy_j(&self.contact.gaps_m)
+    }
+
+    /// H at the rest state, J: the tension over the lowered support, the modes' rest
+    /// deflection and the contact potential at rest.
+    pub fn rest_energy_j(&self) -> f64 {
+        let string = &self.config.string;
+        let line = 0.5 * string.tension_n * string.left_support_m * string.left_support_m
+            / string.length_m;
+        let modes: f64 = self.rest_modal.iter().map(|r| 0.5 * r * r).sum();
+        line + modes + self.points.potential_energy_j(&self.points.rest_gaps_m)
+    }
+
+    /// The discrete energy H of eq. M3, J.
+    pub fn energy_j(&self) -> f64 {
+        self.rest_energy_j() + self.vibration_energy_j()
+    }
+
+    /// The nut force minus its rest value after the last step (eq. 13), N.
+    pub fn nut_force_change_n(&self) -> f64 {
+        self.nut_force_change_n
+    }
+
+    /// The bridge and thread force minus its rest value over the last step (eq. 12), N.
+    pub fn bridge_force_change_n(&self) -> f64 {
+        self.bridge_force_change_n
+    }
+
+    /// The force on the nut after the last step (eq. 13), N.
+    pub fn nut_force_n(&self) -> f64 {
+        self.rest_nut_force_n + self.nut_force_change_n
+    }
+
+    /// The total force of bridge and thread on the string over the last step (eq. 12), N.
+    pub fn bridge_force_n(&self) -> f64 {
+        self.rest_bridge_force_n + self.bridge_force_change_n
+    }
+
+    pub fn rest_nut_force_n(&self) -> f64 {
+        self.rest_nut_force_n
+    }
+
+    pub fn rest_bridge_force_n(&self) -> f64 {
+        self.rest_bridge_force_n
+    }
+
+    /// Energy dissipated since the last reset, J (booked only when `track_energy` is on).
+    pub fn cumulative_losses_j(&self) -> f64 {
+        self.cumulative_losses_j
+    }
+
+    /// Energy added by plucks since the last reset, J.
+    pub fn external_work_j(&self) -> f64 {
+        self.external_work_j
+    }
+
+    pub fn newton_stats(&self) -> &NewtonStats {
+        &self.stats
+    }
+
+    /// Deepest penetration into bridge or thread after the last step, m.
+    pub fn max_penetration_m(&self) -> f64 {
+        self.max_penetration_m
+    }
+
+    pub fn static_solve_failures(&self) -> u64 {
+        self.static_solve_failures
+    }
+
+    pub fn non_finite_resets(&self) -> u64 {
+        self.non_finite_resets
+    }
+
+    pub fn config(&self) -> &ModalStringConfig {
+        &self.config
+    }
+
+    pub fn modes(&self) -> &ModeSet {
+        &self.modes
+    }
+
+    pub fn points(&self) -> &ContactPoints {
+        &self.points
+    }
+
+    /// The gaps a_i of the points now, m (positive: the string penetrates).
+    pub fn gaps_m(&self) -> &[f64] {
+        &self.contact.gaps_m[..self.points.len()]
+    }
+
+    /// The vector unit the mode kernels run on.
+    pub fn vector_unit(&self) -> &'static str {
+        self.kernels.name()
+    }
+
+    /// The fundamental of small vibrations about the rest state with every point in contact at
+    /// rest acting as a spring of its stiffness, Hz (section 5). Allocation-free.
+    pub fn linearised_fundamental_hz(&mut self) -> f64 {
+        linearised_fundamental(
+            &self.points,
+            &self.modes.angular_frequency,
+            self.modes.count(),
+            &mut self.solver,
+            TUNING_ITERATIONS,
+        ) / (2.0 * PI)
+    }
+
+    /// The point nearest the nut in contact at rest, m: the start of the speaking length.
+    pub fn rest_contact_end_m(&self) -> Option<f64> {
+        (0..self.points.len())
+            .filter(|&i| self.points.rest_forces_n[i] > 0.0)
+            .map(|i| self.points.positions_m[i])
+            .reduce(f64::max)
+    }
+}
+
+/// `(2/L) ∫ sin(π(x − x₀)/ℓ) sin(kπx/L) dx` over `[x₀, L]`, ℓ = L − x₀: the first mode of the
+/// speaking length projected on mode k of the whole string, in closed form.
+fn first_mode_projection(start_m: f64, length_m: f64, k: usize) -> f64 {
+    let speaking = length_m - start_m;
+    let alpha = PI / speaking;
+    let beta = k as f64 * PI / length_m;
+    // sin(α(x − x₀)) sin(βx) = ½[cos((α − β)x − αx₀) − cos((α + β)x − αx₀)].
+    let cosine_integral = |u: f64| {
+        // ∫ cos(u x − α x₀) dx over [x₀, L], stable as u → 0.
+        let middle = 0.5 * (start_m + length_m);
+        let half = 0.5 * speaking;
+        let phase = u * middle - alpha * start_m;
+        if (u * half).abs() < 1e-9 {
+            speaking * phase.cos()
+        } else {
+            2.0 * phase.cos() * (u * half).sin() / u
+        }
+    };
+    (2.0 / length_m) * 0.5 * (cosine_integral(alpha - beta) - cosine_integral(alpha + beta))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_mode_projection_matches_quadrature() {
+        let (start, length) = (0.04, 0.668);
+        for k in [1, 2, 7, 30] {
+            let n = 200_000;
+            let dx = (length - start) / n as f64;
+            let numeric: f64 = (0..n)
+                .map(|i| {
+                    let x = start + (i as f64 + 0.5) * dx;
+                    (PI * (x - start) / (length - start)).sin() * (k as f64 * PI * x / length).sin()
+                })
+                .sum::<f64>()
+                * dx
+                * 2.0
+                / length;
+            let closed = first_mode_projection(start, length, k);
+            assert!(
+                (numeric - closed).abs() < 1e-8,
+                "k = {k}: {numeric} vs {closed}"
+            );
+        }
+    }
+}

@@ -1,0 +1,300 @@
+//! The modes of the stiff, lossy string with the lowered support, and the coefficients of their
+//! exact two-pole recursion (`docs/modal-tanpura.md`, sections 1–2).
+//!
+//! `y(x, t) = y_s(x) + Σ_k φ_k(x) q_k(t)`, `y_s(x) = y_TB (1 − x/L)`, `φ_k(x) = sin(β_k x)`,
+//! `β_k = kπ/L`; modal stiffness `κ_k = (L/2)(T β_k² + EI β_k⁴)`, mass `m = ρA L/2`,
+//! `ω_k² = κ_k/m`, decay `σ_k = γ/2 + η ω_k²/2` (seed 000, eq. 5 projected on φ_k). The code
+//! works in `r_k = √κ_k q_k`, so that mode k's potential energy is `r_k²/2` and its shape at a
+//! point is `Ψ_k(x) = φ_k(x)/√κ_k`.
+//!
+//! With the poles `z_k = e^{(−σ_k ± i ω_d,k)Δt}` of the exact recursion, the mid-point form
+//! `s = a p − b r + b (Ψᵀ F)` (eq. M1) has `a = |1 + z|²/2` and `b = |1 − z|²/2`, evaluated as
+//! `((1 ± e)² ∓ 4e sin²(θ/2))/2` with `e = e^{−σΔt}`, `θ = ω_d Δt`, so that the small `b` of the
+//! low modes carries no cancellation. An overdamped mode (σ ≥ ω) takes its two real poles:
+//! `a = (1 + z₁)(1 + z₂)/2`, `b = (1 − z₁)(1 − z₂)/2`. The discrete energy of mode k is
+//! `r²/2 + (a/2b) p²` and it loses `((1 − e²)/2b) s²` per step (eq. M2).
+
+use crate::tanpura::string::StringParameters;
+use std::f64::consts::PI;
+
+/// Most modes a string keeps. The stiffness bounds the count below 20 kHz at about 121 (a 20 Hz
+/// string at the seed's EI and ρA); the capacity is a multiple of the lane padding.
+pub const MODE_CAPACITY: usize = 128;
+/// Modes are kept up to this frequency (nothing above is audible) ...
+pub const AUDIBLE_LIMIT_HZ: f64 = 20_000.0;
+/// ... and below this fraction of the sample rate, so that no pole sits at Nyquist.
+pub const NYQUIST_GUARD: f64 = 0.45;
+
+/// Everything about the modes that depends on the string and the time step, in f64.
+#[derive(Debug, Clone)]
+pub struct ModeSet {
+    count: usize,
+    length_m: f64,
+    /// κ_k, N/m.
+    pub stiffness: Vec<f64>,
+    /// 1/√κ_k.
+    pub inverse_root_stiffness: Vec<f64>,
+    /// ω_k, rad/s (undamped).
+    pub angular_frequency: Vec<f64>,
+    /// σ_k, 1/s.
+    pub decay: Vec<f64>,
+    /// Recursion coefficients of eq. M1.
+    pub a: Vec<f64>,
+    pub b: Vec<f64>,
+    /// a/(2b): the kinetic energy factor of p².
+    pub kinetic_factor: Vec<f64>,
+    /// (1 − det)/(2b): the loss over a step per s².
+    pub loss_factor: Vec<f64>,
+    /// c_k: the nut force of eq. 13 per unit r_k, N per √J.
+    pub nut_weight: Vec<f64>,
+}
+
+impl ModeSet {
+    /// Room for [`MODE_CAPACITY`] modes. Allocates.
+    pub fn new() -> Self {
+        let zeros = || vec![0.0; MODE_CAPACITY];
+        Self {
+            count: 0,
+            length_m: 1.0,
+            stiffness: zeros(),
+            inverse_root_stiffness: zeros(),
+            angular_frequency: zeros(),
+            decay: zeros(),
+            a: zeros(),
+            b: zeros(),
+            kinetic_factor: zeros(),
+            loss_factor: zeros(),
+            nut_weight: zeros(),
+        }
+    }
+
+    /// K, the modes kept.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
+    /// The highest frequency a kept mode may have at this sample rate, Hz.
+    pub fn frequency_limit_hz(sample_rate_hz: f64, highest_mode_hz: f64) -> f64 {
+        highest_mode_hz.min(NYQUIST_GUARD * sample_rate_hz)
+    }
+
+    /// Computes the modes of `string` below `highest_mode_hz` (and below 0.45 of the sample rate)
+    /// and their recursion coefficients for the step `time_step_s`. Allocation-free.
+    pub fn configure(&mut self, string: &StringParameters, time_step_s: f64, highest_mode_hz: f64) {
+        let length = string.length_m;
+        let limit_hz = Self::frequency_limit_hz(1.0 / time_step_s, highest_mode_hz);
+        let half_length = 0.5 * length;
+        let mass = string.linear_density_kg_m * half_length;
+        self.length_m = length;
+        self.count = 0;
+        for index in 0..MODE_CAPACITY {
+            let number = (index + 1) as f64;
+            let wavenumber = number * PI / length;
+            let k2 = wavenumber * wavenumber;
+            let stiffness =
+                half_length * (string.tension_n * k2 + string.bending_stiffness_n_m2 * k2 * k2);
+            let omega = (stiffness / mass).sqrt();
+            if !(omega / (2.0 * PI) < limit_hz) && index > 0 {
+                break;
+            }
+            let decay = 0.5 * string.gamma_per_s + 0.5 * string.eta_s * omega * omega;
+            let (a, b, det) = recursion_coefficients(omega, decay, time_step_s);
+            let root = stiffness.sqrt();
+            let sign = if index % 2 == 0 { 1.0 } else { -1.0 }; // −(−1)^k with k = index + 1
+            self.stiffness[index] = stiffness;
+            self.inverse_root_stiffness[index] = 1.0 / root;
+            self.angular_frequency[index] = omega;
+            self.decay[index] = decay;
+            self.a[index] = a;
+            self.b[index] = b;
+            self.kinetic_factor[index] = a / (2.0 * b);
+            self.loss_factor[index] = (1.0 - det) / (2.0 * b);
+            self.nut_weight[index] = sign
+                * (string.tension_n * wavenumber + string.bending_stiffness_n_m2 * wavenumber * k2)
+                / root;
+            self.count = index + 1;
+        }
+        for index in self.count..MODE_CAPACITY {
+            self.stiffness[index] = 0.0;
+            self.inverse_root_stiffness[index] = 0.0;
+            self.angular_frequency[index] = 0.0;
+            self.decay[index] = 0.0;
+            self.a[index] = 0.0;
+            self.b[index] = 0.0;
+            self.kinetic_factor[index] = 0.0;
+            self.loss_factor[index] = 0.0;
+            self.nut_weight[index] = 0.0;
+        }
+    }
+
+    /// Writes `Ψ_k(x) = sin(kπx/L)/√κ_k` for every kept mode into `row` (zeros beyond K), by the
+    /// recurrence `sin((k+1)θ) = 2 cos θ sin(kθ) − sin((k−1)θ)`. Allocation-free.
+    pub fn shape_row(&self, x_m: f64, row: &mut [f64]) {
+        let theta = PI * x_m / self.length_m;
+        let twice_cos = 2.0 * theta.cos();
+        let (mut previous, mut current) = (0.0, theta.sin());
+        for (index, value) in row.iter_mut().enumerate() {
+            if index < self.count {
+                *value = current * self.inverse_root_stiffness[index];
+                let next = twice_cos * current - previous;
+                previous = current;
+                current = next;
+            } else {
+                *value = 0.0;
+            }
+        }
+    }
+}
+
+impl Default for ModeSet {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// `(a, b, det)` of the recursion whose poles are those of `q̈ + 2σq̇ + ω²q = 0` sampled at Δt.
+pub fn recursion_coefficients(omega: f64, decay: f64, time_step_s: f64) -> (f64, f64, f64) {
+    if decay < omega {
+        let damped = (omega * omega - decay * decay).sqrt();
+        let e = (-decay * time_step_s).exp();
+        let one_minus_e = -(-decay * time_step_s).exp_m1();
+        let half_angle_sine = (0.5 * damped * time_step_s).sin();
+        let cross = 4.0 * e * half_angle_sine * half_angle_sine;
+        let a = 0.5 * ((1.0 + e) * (1.0 + e) - cross);
+        let b = 0.5 * (one_minus_e * one_minus_e + cross);
+        (a, b, e * e)
+    } else {
+        let spread = (decay * decay - omega * omega).sqrt();
+        let slow = ((-decay + spread) * time_step_s).exp();
+        let fast = ((-decay - spread) * time_step_s).exp();
+        let a = 0.5 * (1.0 + slow) * (1.0 + fast);
+        let b = 0.5 * (1.0 - slow) * (1.0 - fast);
+        (a, b, slow * fast)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One mode stepped by eq. M1: returns (r, p) after `steps` steps.
+    fn free_run(a: f64, b: f64, mut r: f64, mut p: f64, steps: usize) -> (f64, f64) {
+        for _ in 0..steps {
+            let s = a * p - b * r;
+            r += s;
+            p = s - p;
+        }
+        (r, p)
+    }
+
+    #[test]
+    fn recursion_has_the_exact_poles() {
+        let dt = 1.0 / 44_100.0;
+        for &(omega, decay) in &[(2.0 * PI * 189.0, 0.3), (2.0 * PI * 15_000.0, 400.0)] {
+            let (a, b, det) = recursion_coefficients(omega, decay, dt);
+            // trace a − b and determinant a + b − 1 of the update matrix.
+            let damped = (omega * omega - decay * decay).sqrt();
+            let trace = 2.0 * (-decay * dt).exp() * (damped * dt).cos();
+            assert!((a - b - trace).abs() < 1e-14);
+            assert!((a + b - 1.0 - det).abs() < 1e-14);
+            assert!((det - (-2.0 * decay * dt).exp()).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn a_mode_released_from_rest_follows_the_exact_damped_cosine() {
+        let dt = 1.0 / 44_100.0;
+        let (omega, decay) = (2.0 * PI * 440.0, 2.5);
+        let (a, b, _) = recursion_coefficients(omega, decay, dt);
+        let steps = 1000;
+        let (r, _) = free_run(a, b, 1.0, 0.0, steps);
+        // The lossless case is exact for q(0) = 1, p = 0; with losses the mid-point velocity
+        // differs from the sampled one by O(σΔt), so compare the envelope and phase closely.
+        let t = steps as f64 * dt;
+        let damped = (omega * omega - decay * decay).sqrt();
+        let exact = (-decay * t).exp() * ((damped * t).cos() + decay / damped * (damped * t).sin());
+        assert!((r - exact).abs() < 1e-4, "{r} vs {exact}");
+        let (a0, b0, _) = recursion_coefficients(omega, 0.0, dt);
+        let (lossless, _) = free_run(a0, b0, 1.0, 0.0, steps);
+        assert!((lossless - (omega * t).cos()).abs() < 1e-10);
+    }
+
+    #[test]
+    fn mode_energy_balance_is_exact() {
+        // eq. M2 for random states and forces: E' − E = s F − loss s².
+        let (a, b, det) = recursion_coefficients(2.0 * PI * 3000.0, 40.0, 1.0 / 48_000.0);
+        for &(r, p, force) in &[(0.3, -0.2, 0.0), (-1.0, 0.7, 0.4), (2e-3, 1e-3, -5e-4)] {
+            let s = a * p - b * r + b * force;
+            let energy = |r: f64, p: f64| 0.5 * r * r + a / (2.0 * b) * p * p;
+            let change = energy(r + s, s - p) - energy(r, p);
+            let expected = s * force - (1.0 - det) / (2.0 * b) * s * s;
+            assert!((change - expected).abs() < 1e-13, "{change} vs {expected}");
+        }
+    }
+
+    #[test]
+    fn the_static_response_is_exact() {
+        // A constant force F settles the mode at r = F (q = Ψ F / √κ, the static deflection).
+        let (a, b, _) = recursion_coefficients(2.0 * PI * 500.0, 30.0, 1.0 / 44_100.0);
+        let force = 0.25;
+        let (mut r, mut p) = (0.0, 0.0);
+        for _ in 0..200_000 {
+            let s = a * p - b * r + b * force;
+            r += s;
+            p = s - p;
+        }
+        assert!((r - force).abs() < 1e-12);
+    }
+
+    #[test]
+    fn overdamped_modes_decay_without_oscillating() {
+        let (a, b, det) = recursion_coefficients(100.0, 1e5, 1e-5);
+        assert!(a > 0.0 && b > 0.0 && det < 1.0);
+        let (mut r, mut p) = (1.0, 0.0);
+        let mut previous = r;
+        for _ in 0..1000 {
+            let s = a * p - b * r;
+            r += s;
+            p = s - p;
+            assert!(r <= previous + 1e-15 && r >= 0.0);
+            previous = r;
+        }
+    }
+
+    #[test]
+    fn the_seed_string_keeps_the_modes_below_20_khz_and_below_nyquist() {
+        let mut modes = ModeSet::new();
+        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, AUDIBLE_LIMIT_HZ);
+        let count = modes.count();
+        let top = modes.angular_frequency[count - 1] / (2.0 * PI);
+        assert!(top < NYQUIST_GUARD * 44_100.0, "{top}");
+        // The next mode would lie above the limit.
+        let next = (count + 1) as f64 * PI / 0.668;
+        let p = StringParameters::SEED;
+        let next_hz = ((p.tension_n * next * next + p.bending_stiffness_n_m2 * next.powi(4))
+            / p.linear_density_kg_m)
+            .sqrt()
+            / (2.0 * PI);
+        assert!(next_hz >= NYQUIST_GUARD * 44_100.0, "{next_hz}");
+        // Mode 1: the full string's fundamental with its stiffness correction.
+        let f1 = modes.angular_frequency[0] / (2.0 * PI);
+        let ideal = p.wave_speed_m_s() / (2.0 * 0.668);
+        let b_coeff = PI * PI * p.bending_stiffness_n_m2 / (p.tension_n * 0.668 * 0.668);
+        assert!((f1 - ideal * (1.0 + b_coeff).sqrt()).abs() < 1e-9);
+        assert!(count > 90 && count < 120, "{count}");
+    }
+
+    #[test]
+    fn shape_rows_are_the_scaled_sines() {
+        let mut modes = ModeSet::new();
+        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, AUDIBLE_LIMIT_HZ);
+        let mut row = vec![0.0; MODE_CAPACITY];
+        modes.shape_row(0.0465, &mut row);
+        for k in 0..modes.count() {
+            let direct =
+                ((k + 1) as f64 * PI * 0.0465 / 0.668).sin() * modes.inverse_root_stiffness[k];
+            assert!((row[k] - direct).abs() < 1e-12 * modes.inverse_root_stiffness[k]);
+        }
+        assert!(row[modes.count()..].iter().all(|&v| v == 0.0));
+    }
+}

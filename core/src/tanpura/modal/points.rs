@@ -1,0 +1,252 @@
+//! The points where the modal string meets the bridge and the thread (`docs/modal-tanpura.md`,
+//! section 3).
+//!
+//! Each point `x_i` stands for a length `w_i` of its barrier (the point spacing), with the
+//! barrier's height `h_i` from `geometry.rs` (the same profiles as the FD tiers), its spring
+//! `w_i k` and its mid-point law scaled to newtons (`contact.rs`, [`HuntCrossley::for_point`]).
+//! For the modes it holds the shapes `Ψ_ik = φ_k(x_i)/√κ_k` and the coupling
+//! `G = Ψ diag(b) Ψᵀ` of eq. M1 (the step of point i per newton at point j, constant while the
+//! string's parameters are), and for the rest state its gaps and forces.
+
+use super::modes::{ModeSet, MODE_CAPACITY};
+use crate::tanpura::contact::HuntCrossley;
+use crate::tanpura::geometry::{BridgeSettings, ThreadSettings};
+
+/// The bridge and thread points of one modal string; allocation-free after `with_capacity`.
+#[derive(Debug, Clone)]
+pub struct ContactPoints {
+    count: usize,
+    bridge_count: usize,
+    capacity: usize,
+    pub positions_m: Vec<f64>,
+    pub heights_m: Vec<f64>,
+    /// w_i, m: the barrier length a point stands for.
+    pub weights_m: Vec<f64>,
+    /// w_i k, N/m: the point's static spring.
+    pub springs_n_m: Vec<f64>,
+    pub laws: Vec<HuntCrossley>,
+    /// g_i = h_i − y_s(x_i): the gap over the straight line between the supports, m.
+    pub free_gaps_m: Vec<f64>,
+    /// Ψ rows, `capacity × MODE_CAPACITY`, zero beyond the kept modes.
+    pub shapes: Vec<f64>,
+    /// G = Ψ diag(b) Ψᵀ, `capacity × capacity`, row-major.
+    pub coupling: Vec<f64>,
+    /// The rest state: gaps a_rest,i (m) and forces F_rest,i = w_i k ⌊a_rest,i⌋ (N).
+    pub rest_gaps_m: Vec<f64>,
+    pub rest_forces_n: Vec<f64>,
+}
+
+/// Points of a grid covering `[start, end]` with the given spacing (at least one).
+pub fn grid_points(start_m: f64, end_m: f64, spacing_m: f64) -> usize {
+    ((end_m - start_m) / spacing_m).floor().max(0.0) as usize + 1
+}
+
+impl ContactPoints {
+    /// Room for `capacity` points. Allocates.
+    pub fn with_capacity(capacity: usize) -> Self {
+        let zeros = |n: usize| vec![0.0; n];
+        Self {
+            count: 0,
+            bridge_count: 0,
+            capacity,
+            positions_m: zeros(capacity),
+            heights_m: zeros(capacity),
+            weights_m: zeros(capacity),
+            springs_n_m: zeros(capacity),
+            laws: vec![HuntCrossley { xi: 0.0, psi: 0.0 }; capacity],
+            free_gaps_m: zeros(capacity),
+            shapes: zeros(capacity * MODE_CAPACITY),
+            coupling: zeros(capacity * capacity),
+            rest_gaps_m: zeros(capacity),
+            rest_forces_n: zeros(capacity),
+        }
+    }
+
+    /// M, the points in use (bridge first, then thread).
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+
+    /// The bridge points are `0..bridge_count()`, the thread's the rest.
+    pub fn bridge_count(&self) -> usize {
+        self.bridge_count
+    }
+
+    /// Ψ_i, the shapes of the modes at point i.
+    pub fn shape(&self, i: usize) -> &[f64] {
+        &self.shapes[i * MODE_CAPACITY..(i + 1) * MODE_CAPACITY]
+    }
+
+    /// G_ij.
+    #[inline]
+    pub fn coupling(&self, i: usize, j: usize) -> f64 {
+        self.coupling[i * self.capacity + j]
+    }
+
+    /// Places the points on bridge and thread (a point per `spacing` over the part of each
+    /// barrier with a positive stiffness) and sets their laws for the step `time_step_s`.
+    /// Points beyond the capacity are dropped. `left_support_m` and `length_m` give the line
+    /// y_s. Allocation-free.
+    #[allow(clippy::too_many_arguments)]
+    pub fn place(
+        &mut self,
+        bridge: &BridgeSettings,
+        bridge_start_m: f64,
+        bridge_end_m: f64,
+        bridge_spacing_m: f64,
+        thread: Option<&ThreadSettings>,
+        thread_spacing_m: f64,
+        time_step_s: f64,
+        left_support_m: f64,
+        length_m: f64,
+    ) {
+        self.count = 0;
+        if bridge.stiffness_n_m2 > 0.0 && bridge_end_m > bridge_start_m {
+            let points = grid_points(bridge_start_m, bridge_end_m, bridge_spacing_m);
+            for index in 0..points {
+                let x = bridge_start_m + index as f64 * bridge_spacing_m;
+                self.push(
+                    x,
+                    bridge.height_m(x),
+                    bridge_spacing_m,
+                    bridge.stiffness_n_m2,
+                    bridge.damping_s_m,
+                    time_step_s,
+                );
+            }
+        }
+        self.bridge_count = self.count;
+        if let Some(thread) = thread.filter(|thread| thread.stiffness_n_m2 > 0.0) {
+            // Symmetric about the thread, with a point on its top.
+            let side = (thread.half_width_m() / thread_spacing_m).floor() as usize;
+            for index in 0..2 * side + 1 {
+                let x = thread.position_m + (index as f64 - side as f64) * thread_spacing_m;
+                self.push(
+                    x,
+                    thread.height_over(bridge, x),
+                    thread_spacing_m,
+                    thread.stiffness_n_m2,
+                    thread.damping_s_m,
+                    time_step_s,
+                );
+            }
+        }
+        for i in 0..self.count {
+            let line = left_support_m * (1.0 - self.positions_m[i] / length_m);
+            self.free_gaps_m[i] = self.heights_m[i] - line;
+        }
+    }
+
+    fn push(
+        &mut self,
+        x_m: f64,
+        height_m: f64,
+        spacing_m: f64,
+        stiffness_n_m2: f64,
+        damping_s_m: f64,
+        time_step_s: f64,
+    ) {
+        if self.count == self.capacity {
+            return;
+        }
+        let i = self.count;
+        self.positions_m[i] = x_m;
+        self.heights_m[i] = height_m;
+        self.weights_m[i] = spacing_m;
+        self.springs_n_m[i] = stiffness_n_m2 * spacing_m;
+        self.laws[i] = HuntCrossley::for_point(stiffness_n_m2, damping_s_m, spacing_m, time_step_s);
+        self.count += 1;
+    }
+
+    /// Recomputes Ψ and G for the modes (after [`ContactPoints::place`] or a change of the
+    /// string's parameters). Allocation-free; O(M K + M² K).
+    pub fn couple(&mut self, modes: &ModeSet) {
+        let count = modes.count();
+        for i in 0..self.count {
+            let x = self.positions_m[i];
+            modes.shape_row(
+                x,
+                &mut self.shapes[i * MODE_CAPACITY..(i + 1) * MODE_CAPACITY],
+            );
+        }
+        for i in 0..self.count {
+            for j in 0..=i {
+                let (row_i, row_j) = (self.shape(i), self.shape(j));
+                let mut sum = 0.0;
+                for k in 0..count {
+                    sum += row_i[k] * modes.b[k] * row_j[k];
+                }
+                self.coupling[i * self.capacity + j] = sum;
+                self.coupling[j * self.capacity + i] = sum;
+            }
+        }
+    }
+
+    /// The contact potential `Σ_i w_i k/2 ⌊a_i⌋²` for the gaps `gaps_m`, J.
+    pub fn potential_energy_j(&self, gaps_m: &[f64]) -> f64 {
+        (0..self.count)
+            .map(|i| {
+                let penetration = gaps_m[i].max(0.0);
+                0.5 * self.springs_n_m[i] * penetration * penetration
+            })
+            .sum()
+    }
+
+    /// The contact part of the vibration energy: the Bregman divergence
+    /// `Σ_i V_i(a_i) − V_i(a_rest,i) − V_i'(a_rest,i)(a_i − a_rest,i) ≥ 0`, J (section 4).
+    pub fn excess_energy_j(&self, gaps_m: &[f64]) -> f64 {
+        (0..self.count)
+            .map(|i| {
+                let spring = self.springs_n_m[i];
+                let (gap, rest) = (gaps_m[i], self.rest_gaps_m[i]);
+                let potential = |a: f64| 0.5 * spring * a.max(0.0) * a.max(0.0);
+                potential(gap) - potential(rest) - self.rest_forces_n[i] * (gap - rest)
+            })
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tanpura::string::StringParameters;
+
+    #[test]
+    fn coupling_is_symmetric_and_its_diagonal_positive() {
+        let mut modes = ModeSet::new();
+        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, 20_000.0);
+        let mut points = ContactPoints::with_capacity(64);
+        let bridge = BridgeSettings::SEED;
+        let thread = ThreadSettings::SEED;
+        points.place(
+            &bridge,
+            bridge.start_m,
+            bridge.end_m,
+            1e-3,
+            Some(&thread),
+            1e-3,
+            1.0 / 44_100.0,
+            -2e-3,
+            0.668,
+        );
+        points.couple(&modes);
+        assert!(points.len() > 30);
+        for i in 0..points.len() {
+            assert!(points.coupling(i, i) > 0.0);
+            for j in 0..points.len() {
+                assert_eq!(points.coupling(i, j), points.coupling(j, i));
+            }
+        }
+        // The thread's middle point sits on its top.
+        let top = points.bridge_count() + (points.len() - points.bridge_count()) / 2;
+        assert!((points.positions_m[top] - thread.position_m).abs() < 1e-12);
+    }
+}

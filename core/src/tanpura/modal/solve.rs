@@ -1,0 +1,846 @@
+//! The contact solves of the modal tiers (`docs/modal-tanpura.md`, sections 4–5).
+//!
+//! **Dynamic step.** With `Δu_free = Ψ s_free` and the coupling `G`, the points' step solves
+//! `R(Δu) = Δu − Δu_free − G (F(Δu) − F_rest) = 0`, where F is the seed's mid-point force of
+//! every point (eq. 4, `contact.rs`). Newton's Jacobian is `J = I + G C`, `C = diag(−∂F/∂Δu)`.
+//! On the points A with `c_i > 0` the update solves `(I + D G_AA D) y = −D R_A`, `D = diag(√c_i)`,
+//! then `δ = −R − G_{:,A} D y` for every point: the exact `δ = −J⁻¹ R`, through a symmetric
+//! positive definite matrix whose eigenvalues are at least 1 (never ill-conditioned, however
+//! close the points or stiff the contact). Residual and Jacobian are those of the full step, so
+//! the accepted Δu satisfies the scheme to the tolerance and the energy balance (eq. M3) holds.
+//! Stops when `max|δ| ≤ tolerance`; at the cap the last iterate is taken and counted
+//! (`newton.rs`).
+//!
+//! **Static problems** (rest state, pressed finger). The equilibrium minimises the convex
+//! `Π(r) = |r|²/2 + Σ_i w_i k/2 ⌊g_i − Ψ_i r⌋²`; at the minimum `r = Σ_i F_i Ψ_i`. Newton's step
+//! for the current contact set A is the exact minimiser of the quadratic model,
+//! `F_A = D (I + D G^s_AA D)⁻¹ D g_A` with `G^s = Ψ Ψᵀ` and `D = diag(√(w_i k))`; a backtracking
+//! line search on Π makes it converge from any start, and it ends exactly once the contact set
+//! stops changing (the problem is piecewise quadratic).
+//!
+//! **Linearised fundamental.** The lowest eigenvalue of `(I + Ψ_Aᵀ C Ψ_A) x = ω² diag(1/ω_k²) x`
+//! (the modes with a spring at every point in contact at rest), by inverse iteration; the
+//! inverse is applied through the Woodbury identity in O(|A| K).
+
+use super::modes::MODE_CAPACITY;
+use super::points::ContactPoints;
+use crate::dense::DenseCholesky;
+use crate::newton::NewtonSettings;
+use crate::tanpura::contact::HuntCrossley;
+
+/// Per-step state of the points; allocation-free after `new`.
+///
+/// Only the *tracked* points, those near contact, take part in Newton's iteration. Every other
+/// point's step follows from the converged forces; one that would touch joins the tracked set and
+/// the solve is redone before the step is taken (`ModalString::step`), so the solve is exact for
+/// every point.
+#[derive(Debug, Clone)]
+pub struct ContactStep {
+    /// a_i before the step, m.
+    pub gaps_m: Vec<f64>,
+    /// Ψ_i · s_free, m.
+    pub free_steps_m: Vec<f64>,
+    /// Δu_i, m: the accepted step of every point.
+    pub steps_m: Vec<f64>,
+    /// The last accepted Δu − Δu_free of the tracked points: the next step's initial guess.
+    pub corrections_m: Vec<f64>,
+    /// The tracked points, and a flag per point.
+    pub tracked: Vec<usize>,
+    pub tracked_count: usize,
+    pub is_tracked: Vec<bool>,
+    /// Points with F ≠ F_rest after the solve, and their F − F_rest, N.
+    pub loaded: Vec<usize>,
+    pub loaded_count: usize,
+    pub force_changes_n: Vec<f64>,
+    /// Newton's problem on the tracked points, in their order.
+    pub local: TrackedSolve,
+    /// Whether `local`'s block of G must be copied again (the tracked set or G changed).
+    block_stale: bool,
+}
+
+impl ContactStep {
+    /// Room for `capacity` points. Allocates.
+    pub fn new(capacity: usize) -> Self {
+        let zeros = || vec![0.0; capacity];
+        Self {
+            gaps_m: zeros(),
+            free_steps_m: zeros(),
+            steps_m: zeros(),
+            corrections_m: zeros(),
+            tracked: vec![0; capacity],
+            tracked_count: 0,
+            is_tracked: vec![false; capacity],
+            loaded: vec![0; capacity],
+            loaded_count: 0,
+            force_changes_n: zeros(),
+            local: TrackedSolve::new(capacity),
+            block_stale: true,
+        }
+    }
+
+    /// Starts tracking point i.
+    pub fn track(&mut self, i: usize) {
+        if !self.is_tracked[i] {
+            self.is_tracked[i] = true;
+            self.tracked[self.tracked_count] = i;
+            self.tracked_count += 1;
+            self.block_stale = true;
+        }
+    }
+
+    /// Stops tracking the points farther than `distance_m` from contact that carry no force now
+    /// and none at rest, keeping the others in order.
+    pub fn release_far(&mut self, points: &ContactPoints, distance_m: f64) {
+        let mut kept = 0;
+        for index in 0..self.tracked_count {
+            let i = self.tracked[index];
+            let far = self.gaps_m[i] < -distance_m
+                && self.local.force_n(index) == 0.0
+                && points.rest_forces_n[i] == 0.0;
+            if far {
+                self.is_tracked[i] = false;
+                self.corrections_m[i] = 0.0;
+                self.block_stale = true;
+            } else {
+                self.tracked[kept] = i;
+                kept += 1;
+            }
+        }
+        self.tracked_count = kept;
+    }
+
+    /// The coupling G changed (new string parameters): copy the tracked block again.
+    pub fn coupling_changed(&mut self) {
+        self.block_stale = true;
+    }
+
+    /// Tracks the points whose gap lies within `band_m` of contact or that carry a force at rest.
+    pub fn classify(&mut self, points: &ContactPoints, band_m: f64) {
+        self.tracked_count = 0;
+        self.block_stale = true;
+        for i in 0..points.len() {
+            self.is_tracked[i] = false;
+            if self.gaps_m[i] > -band_m || points.rest_forces_n[i] != 0.0 {
+                self.track(i);
+            }
+        }
+    }
+
+    /// Copies the tracked points' state and their block of G into the compact problem; Newton
+    /// starts from `Δu_free + correction`.
+    pub fn gather(&mut self, points: &ContactPoints) {
+        let local = &mut self.local;
+        let count = self.tracked_count;
+        local.count = count;
+        for (t, &i) in self.tracked[..count].iter().enumerate() {
+            local.gaps[t] = self.gaps_m[i];
+            local.free_steps[t] = self.free_steps_m[i];
+            local.steps[t] = self.free_steps_m[i] + self.corrections_m[i];
+            local.rest_forces[t] = points.rest_forces_n[i];
+            local.laws[t] = points.laws[i];
+        }
+        if self.block_stale {
+            for (t, &i) in self.tracked[..count].iter().enumerate() {
+                for (u, &j) in self.tracked[..count].iter().enumerate() {
+                    local.coupling[t * count + u] = points.coupling(i, j);
+                }
+            }
+            self.block_stale = false;
+        }
+    }
+
+    /// Takes the solved steps and forces back: Δu of the tracked points, the loaded list in point
+    /// indices, the corrections for the next step's guess.
+    pub fn publish(&mut self) {
+        let local = &self.local;
+        for (t, &i) in self.tracked[..self.tracked_count].iter().enumerate() {
+            self.steps_m[i] = local.steps[t];
+            self.corrections_m[i] = local.steps[t] - local.free_steps[t];
+        }
+        self.loaded_count = local.loaded_count;
+        for (slot, &t) in local.loaded[..local.loaded_count].iter().enumerate() {
+            self.loaded[slot] = self.tracked[t];
+            self.force_changes_n[slot] = local.changes[t];
+        }
+    }
+}
+
+/// Newton's method on the tracked points, in compact arrays (section 4 of the derivation).
+///
+/// With the contact law of [`HuntCrossley::midpoint_force_linear_damping`] the residual is
+/// linear while every point stays in contact or stays out, so an update that changes no point's
+/// case is exact: the iteration stops there, without a further update to confirm it.
+#[derive(Debug, Clone)]
+pub struct TrackedSolve {
+    count: usize,
+    gaps: Vec<f64>,
+    free_steps: Vec<f64>,
+    steps: Vec<f64>,
+    rest_forces: Vec<f64>,
+    laws: Vec<HuntCrossley>,
+    /// F, c = −∂F/∂Δu, Φ and F − F_rest at the last evaluation.
+    forces: Vec<f64>,
+    stiffnesses: Vec<f64>,
+    squared_gap_changes: Vec<f64>,
+    changes: Vec<f64>,
+    /// Local indices with F ≠ F_rest at the last evaluation.
+    loaded: Vec<usize>,
+    loaded_count: usize,
+    /// G on the tracked points, `count × count`.
+    coupling: Vec<f64>,
+    residual: Vec<f64>,
+    roots: Vec<f64>,
+    matrix: Vec<f64>,
+    solution: Vec<f64>,
+    scratch: Vec<f64>,
+}
+
+/// Solves `A x = b` in place for the SPD `n × n` matrix whose lower triangle is in `matrix`
+/// (row-major), by an LDLᵀ factorisation written over it: `L` below the diagonal, `D` on it. No
+/// pivoting and no square roots: the tracked solve's matrices have eigenvalues ≥ 1. `scratch`
+/// holds `L_jk d_k` for the row being factorised.
+fn ldl_solve_in_place(matrix: &mut [f64], n: usize, x: &mut [f64], scratch: &mut [f64]) {
+    for j in 0..n {
+        // w_k = L_jk d_k; d_j = a_jj − Σ_k L_jk w_k.
+        let mut diagonal = matrix[j * n + j];
+        for k in 0..j {
+            let weighted = matrix[j * n + k] * matrix[k * n + k];
+            scratch[k] = weighted;
+            diagonal -= matrix[j * n + k] * weighted;
+        }
+        matrix[j * n + j] = diagonal;
+        // L_ij = (a_ij − Σ_k L_ik w_k) / d_j for the rows below.
+        for i in j + 1..n {
+            let row = &matrix[i * n..i * n + j];
+            let sum: f64 = row.iter().zip(&scratch[..j]).map(|(l, w)| l * w).sum();
+            matrix[i * n + j] = (matrix[i * n + j] - sum) / diagonal;
+        }
+    }
+    // L y = b, then D z = y, then Lᵀ x = z.
+    for i in 0..n {
+        let row = &matrix[i * n..i * n + i];
+        let sum: f64 = row.iter().zip(&x[..i]).map(|(l, v)| l * v).sum();
+        x[i] -= sum;
+    }
+    for i in 0..n {
+        x[i] /= matrix[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let value = x[i];
+        for k in 0..i {
+            x[k] -= matrix[i * n + k] * value;
+        }
+    }
+}
+
+/// Tracked points up to which the Newton update runs on fixed-size arrays.
+const SMALL: usize = 8;
+
+/// [`ldl_solve_in_place`] on a fixed-size matrix (lower triangle used).
+fn ldl_solve_small(matrix: &mut [[f64; SMALL]; SMALL], x: &mut [f64; SMALL]) {
+    let mut weighted = [0.0; SMALL];
+    for j in 0..SMALL {
+        let mut diagonal = matrix[j][j];
+        for k in 0..j {
+            weighted[k] = matrix[j][k] * matrix[k][k];
+            diagonal -= matrix[j][k] * weighted[k];
+        }
+        matrix[j][j] = diagonal;
+        for i in j + 1..SMALL {
+            let mut value = matrix[i][j];
+            for k in 0..j {
+                value -= matrix[i][k] * weighted[k];
+            }
+            matrix[i][j] = value / diagonal;
+        }
+    }
+    for i in 0..SMALL {
+        for k in 0..i {
+            x[i] -= matrix[i][k] * x[k];
+        }
+    }
+    for i in 0..SMALL {
+        x[i] /= matrix[i][i];
+    }
+    for i in (0..SMALL).rev() {
+        for k in 0..i {
+            x[k] -= matrix[i][k] * x[i];
+        }
+    }
+}
+
+/// Whether a point is in contact before and after a step `step` from gap `gap`.
+#[inline]
+fn contact_case(gap: f64, step: f64) -> (bool, bool) {
+    (gap > 0.0, gap - step > 0.0)
+}
+
+impl TrackedSolve {
+    fn new(capacity: usize) -> Self {
+        let zeros = || vec![0.0; capacity];
+        Self {
+            count: 0,
+            gaps: zeros(),
+            free_steps: zeros(),
+            steps: zeros(),
+            rest_forces: zeros(),
+            laws: vec![HuntCrossley { xi: 0.0, psi: 0.0 }; capacity],
+            forces: zeros(),
+            stiffnesses: zeros(),
+            squared_gap_changes: zeros(),
+            changes: zeros(),
+            loaded: vec![0; capacity],
+            loaded_count: 0,
+            coupling: vec![0.0; capacity * capacity],
+            residual: zeros(),
+            roots: zeros(),
+            matrix: vec![0.0; capacity * capacity],
+            solution: zeros(),
+            scratch: zeros(),
+        }
+    }
+
+    /// Evaluates every point's force at the iterate and lists the points whose force differs
+    /// from its rest value.
+    pub fn evaluate(&mut self) {
+        let count = self.count;
+        self.loaded_count = 0;
+        let points = self.laws[..count]
+            .iter()
+            .zip(&self.gaps[..count])
+            .zip(&self.steps[..count])
+            .zip(&self.rest_forces[..count]);
+        for (t, (((law, &gap), &step), &rest)) in points.enumerate() {
+            let contact = law.midpoint_force_linear_damping(gap, step);
+            self.forces[t] = contact.force;
+            self.stiffnesses[t] = contact.stiffness;
+            self.squared_gap_changes[t] = contact.squared_gap_change;
+            let change = contact.force - rest;
+            self.changes[t] = change;
+            if change != 0.0 {
+                self.loaded[self.loaded_count] = t;
+                self.loaded_count += 1;
+            }
+        }
+    }
+
+    /// Whether no point can exert a force different from its rest force during the free step:
+    /// nothing rests in contact and nothing touches before or after. Then the free step is the
+    /// exact solution and the forces are zero.
+    pub fn settle_if_free(&mut self) -> bool {
+        let count = self.count;
+        let free = self.rest_forces[..count]
+            .iter()
+            .zip(&self.gaps[..count])
+            .zip(&self.free_steps[..count])
+            .all(|((&rest, &gap), &free)| rest == 0.0 && gap <= 0.0 && gap - free <= 0.0);
+        if free {
+            self.loaded_count = 0;
+            self.steps[..count].copy_from_slice(&self.free_steps[..count]);
+            self.forces[..count].fill(0.0);
+            self.changes[..count].fill(0.0);
+            self.squared_gap_changes[..count].fill(0.0);
+        }
+        free
+    }
+
+    /// Newton's iteration from the current steps: at most `settings.max_iterations` updates;
+    /// stops when the largest update is within the tolerance or when an update left every
+    /// point's contact case unchanged in a linear regime (exact). Returns (updates, converged).
+    pub fn solve(&mut self, settings: &NewtonSettings) -> (u32, bool) {
+        let cap = settings.max_iterations.max(1);
+        for iteration in 1..=cap {
+            self.evaluate();
+            let linear = (0..self.count).all(|t| {
+                let (before, after) = contact_case(self.gaps[t], self.steps[t]);
+                before == after
+            });
+            let largest = self.update();
+            if !largest.is_finite() {
+                return (iteration, false);
+            }
+            // Linear at the evaluation point and still in the same cases after the update: the
+            // law was linear all the way, so the update solved the step exactly.
+            let unchanged = linear
+                && (0..self.count).all(|t| {
+                    let (before, after) = contact_case(self.gaps[t], self.steps[t]);
+                    before == after
+                });
+            if largest <= settings.tolerance_m || unchanged {
+                return (iteration, true);
+            }
+        }
+        (cap, false)
+    }
+
+    /// One Newton update `δ = −J⁻¹ R` at the last evaluation; applies it and returns its largest
+    /// component (NaN when the state is not finite). Up to [`SMALL`] tracked points the update
+    /// runs on fixed-size arrays (padded with inert rows), which the compiler unrolls; the same
+    /// algorithm on the heap buffers serves larger contact sets.
+    fn update(&mut self) -> f64 {
+        if self.count <= SMALL {
+            self.update_small()
+        } else {
+            self.update_any()
+        }
+    }
+
+    fn update_small(&mut self) -> f64 {
+        let count = self.count;
+        let mut coupling = [[0.0; SMALL]; SMALL];
+        let mut changes = [0.0; SMALL];
+        let mut roots = [0.0; SMALL];
+        let mut residual = [0.0; SMALL];
+        for t in 0..count {
+            coupling[t][..count].copy_from_slice(&self.coupling[t * count..(t + 1) * count]);
+            changes[t] = self.changes[t];
+            roots[t] = self.stiffnesses[t].sqrt();
+        }
+        // R = Δu − Δu_free − G ΔF (zero on the padding rows).
+        for t in 0..count {
+            let coupled: f64 = (0..SMALL).map(|u| coupling[t][u] * changes[u]).sum();
+            residual[t] = self.steps[t] - self.free_steps[t] - coupled;
+        }
+        // (I + D G D) y = −D R, lower triangle; the padding rows are identity rows with y = 0.
+        let mut matrix = [[0.0; SMALL]; SMALL];
+        let mut y = [0.0; SMALL];
+        for t in 0..SMALL {
+            for u in 0..SMALL {
+                matrix[t][u] = roots[t] * coupling[t][u] * roots[u];
+            }
+            matrix[t][t] += 1.0;
+            y[t] = -roots[t] * residual[t];
+        }
+        ldl_solve_small(&mut matrix, &mut y);
+        for t in 0..SMALL {
+            y[t] *= roots[t];
+        }
+        // δ = −R − G D y.
+        let mut largest = 0.0f64;
+        for t in 0..count {
+            let coupled: f64 = (0..SMALL).map(|u| coupling[t][u] * y[u]).sum();
+            let delta = -residual[t] - coupled;
+            self.steps[t] += delta;
+            largest = largest.max(delta.abs());
+        }
+        if y.iter().all(|v| v.is_finite()) {
+            largest
+        } else {
+            f64::NAN
+        }
+    }
+
+    fn update_any(&mut self) -> f64 {
+        let count = self.count;
+        let coupling = &self.coupling[..count * count];
+        let changes = &self.changes[..count];
+        // R = Δu − Δu_free − G ΔF; D = diag(√c).
+        for (t, row) in coupling.chunks_exact(count).enumerate() {
+            let coupled: f64 = row.iter().zip(changes).map(|(g, f)| g * f).sum();
+            self.residual[t] = self.steps[t] - self.free_steps[t] - coupled;
+            self.roots[t] = self.stiffnesses[t].sqrt();
+        }
+        let roots = &self.roots[..count];
+        // (I + D G D) y = −D R over every tracked point: a point without a Jacobian entry has
+        // D = 0, an identity row, and y = 0. The matrix is SPD with eigenvalues ≥ 1, so LDLᵀ
+        // without pivoting is exact and stable; it is a handful of rows, factorised in place.
+        let matrix = &mut self.matrix[..count * count];
+        for (t, row) in coupling.chunks_exact(count).enumerate() {
+            let root = roots[t];
+            for u in 0..=t {
+                matrix[t * count + u] = root * row[u] * roots[u];
+            }
+            matrix[t * count + t] += 1.0;
+            self.solution[t] = -root * self.residual[t];
+        }
+        let solution = &mut self.solution[..count];
+        ldl_solve_in_place(matrix, count, solution, &mut self.scratch[..count]);
+        for (y, root) in solution.iter_mut().zip(roots) {
+            *y *= root;
+        }
+        // δ = −R − G D y.
+        let mut largest = 0.0f64;
+        for (t, row) in coupling.chunks_exact(count).enumerate() {
+            let coupled: f64 = row.iter().zip(&*solution).map(|(g, y)| g * y).sum();
+            let delta = -self.residual[t] - coupled;
+            self.steps[t] += delta;
+            largest = largest.max(delta.abs());
+        }
+        if solution.iter().all(|y| y.is_finite()) {
+            largest
+        } else {
+            f64::NAN
+        }
+    }
+
+    /// The contact damping's loss over the step at the last evaluation, J.
+    pub fn damping_loss_j(&self) -> f64 {
+        let count = self.count;
+        self.laws[..count]
+            .iter()
+            .zip(&self.gaps[..count])
+            .zip(&self.steps[..count])
+            .map(|((law, &gap), &step)| law.linear_damping_loss(gap, step))
+            .sum()
+    }
+
+    /// The force of the t-th tracked point at the last evaluation, N.
+    pub fn force_n(&self, t: usize) -> f64 {
+        self.forces[t]
+    }
+}
+
+/// Static equilibrium of the string on a set of points (bridge, thread and maybe finger).
+#[derive(Debug, Clone)]
+pub struct StaticSolver {
+    capacity: usize,
+    /// Ψ rows of the points, `capacity × MODE_CAPACITY`.
+    pub shapes: Vec<f64>,
+    /// g_i, m, and w_i k, N/m.
+    pub free_gaps_m: Vec<f64>,
+    pub springs_n_m: Vec<f64>,
+    /// The forces at the solution (and the warm start on entry), N.
+    pub forces_n: Vec<f64>,
+    /// r = Σ F_i Ψ_i at the solution.
+    pub modal: Vec<f64>,
+    /// u_i = Ψ_i · r at the solution, m.
+    pub displacements_m: Vec<f64>,
+    trial_forces: Vec<f64>,
+    blended_forces: Vec<f64>,
+    trial_modal: Vec<f64>,
+    trial_displacements: Vec<f64>,
+    active: Vec<usize>,
+    previous_active: Vec<usize>,
+    roots: Vec<f64>,
+    matrix: Vec<f64>,
+    solution: Vec<f64>,
+    factor: DenseCholesky,
+}
+
+/// Newton updates a static solve may take; each ends the piecewise-linear problem's current
+/// contact set, so a handful suffice (the line search makes up to this many safe).
+const STATIC_MAX_ITERATIONS: usize = 100;
+
+impl StaticSolver {
+    /// Room for `capacity` points. Allocates.
+    pub fn new(capacity: usize) -> Self {
+        let zeros = |n: usize| vec![0.0; n];
+        Self {
+            capacity,
+            shapes: zeros(capacity * MODE_CAPACITY),
+            free_gaps_m: zeros(capacity),
+            springs_n_m: zeros(capacity),
+            forces_n: zeros(capacity),
+            modal: zeros(MODE_CAPACITY),
+            displacements_m: zeros(capacity),
+            trial_forces: zeros(capacity),
+            blended_forces: zeros(capacity),
+            trial_modal: zeros(MODE_CAPACITY),
+            trial_displacements: zeros(capacity),
+            active: vec![0; capacity],
+            previous_active: vec![0; capacity],
+            roots: zeros(capacity),
+            matrix: zeros(capacity * capacity),
+            solution: zeros(capacity),
+            factor: DenseCholesky::with_capacity(capacity),
+        }
+    }
+
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+
+    /// Loads the bridge and thread points as the first rows; returns their count.
+    pub fn load_points(&mut self, points: &ContactPoints) -> usize {
+        let count = points.len().min(self.capacity);
+        self.shapes[..count * MODE_CAPACITY]
+            .copy_from_slice(&points.shapes[..count * MODE_CAPACITY]);
+        self.free_gaps_m[..count].copy_from_slice(&points.free_gaps_m[..count]);
+        self.springs_n_m[..count].copy_from_slice(&points.springs_n_m[..count]);
+        count
+    }
+
+    fn shape(&self, i: usize) -> &[f64] {
+        &self.shapes[i * MODE_CAPACITY..(i + 1) * MODE_CAPACITY]
+    }
+
+    /// r = Σ_i forces_i Ψ_i and u = Ψ r for `count` points over `modes` modes.
+    fn modal_response(
+        shapes: &[f64],
+        count: usize,
+        modes: usize,
+        forces: &[f64],
+        modal: &mut [f64],
+        displacements: &mut [f64],
+    ) {
+        modal[..modes].fill(0.0);
+        for i in 0..count {
+            let force = forces[i];
+            if force != 0.0 {
+                let row = &shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + modes];
+                for (m, psi) in modal[..modes].iter_mut().zip(row) {
+                    *m += force * psi;
+                }
+            }
+        }
+        for i in 0..count {
+            let row = &shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + modes];
+            displacements[i] = row.iter().zip(&modal[..modes]).map(|(a, b)| a * b).sum();
+        }
+    }
+
+    fn energy(&self, count: usize, modes: usize, modal: &[f64], displacements: &[f64]) -> f64 {
+        let string: f64 = modal[..modes].iter().map(|r| 0.5 * r * r).sum();
+        let contact: f64 = (0..count)
+            .map(|i| {
+                let penetration = (self.free_gaps_m[i] - displacements[i]).max(0.0);
+                0.5 * self.springs_n_m[i] * penetration * penetration
+            })
+            .sum();
+        string + contact
+    }
+
+    /// Solves for `count` points over `modes` modes, starting from `forces_n`. Returns whether it
+    /// converged. Allocation-free.
+    pub fn solve(&mut self, count: usize, modes: usize) -> bool {
+        Self::modal_response(
+            &self.shapes,
+            count,
+            modes,
+            &self.forces_n,
+            &mut self.modal,
+            &mut self.displacements_m,
+        );
+        let mut energy = self.energy(count, modes, &self.modal, &self.displacements_m);
+        let mut previous_size = usize::MAX;
+        for _ in 0..STATIC_MAX_ITERATIONS {
+            // The contact set of the current iterate.
+            let mut size = 0;
+            for i in 0..count {
+                if self.free_gaps_m[i] - self.displacements_m[i] > 0.0 {
+                    self.active[size] = i;
+                    self.roots[size] = self.springs_n_m[i].sqrt();
+                    size += 1;
+                }
+            }
+            let settled = size == previous_size
+                && self.active[..size] == self.previous_active[..size]
+                && (0..count).all(|i| {
+                    let expected = self.springs_n_m[i]
+                        * (self.free_gaps_m[i] - self.displacements_m[i]).max(0.0);
+                    (self.forces_n[i] - expected).abs() <= 1e-12 * expected.abs().max(1e-9)
+                });
+            if settled {
+                return true;
+            }
+            // The minimiser of the quadratic model: F_A = D (I + D G_AA D)⁻¹ D g_A.
+            for row in 0..size {
+                let i = self.active[row];
+                for column in 0..=row {
+                    let j = self.active[column];
+                    let dot: f64 = self.shape(i)[..modes]
+                        .iter()
+                        .zip(&self.shape(j)[..modes])
+                        .map(|(a, b)| a * b)
+                        .sum();
+                    let value = self.roots[row] * dot * self.roots[column]
+                        + if row == column { 1.0 } else { 0.0 };
+                    self.matrix[row * size + column] = value;
+                    self.matrix[column * size + row] = value;
+                }
+                self.solution[row] = self.roots[row] * self.free_gaps_m[i];
+            }
+            if size > 0 {
+                if self
+                    .factor
+                    .factorise(&self.matrix[..size * size], size)
+                    .is_err()
+                {
+                    return false;
+                }
+                self.factor.solve_in_place(&mut self.solution[..size]);
+            }
+            self.trial_forces[..count].fill(0.0);
+            for row in 0..size {
+                self.trial_forces[self.active[row]] = self.roots[row] * self.solution[row];
+            }
+            // Backtracking on the convex Π along the Newton direction.
+            let mut fraction = 1.0;
+            loop {
+                for i in 0..count {
+                    self.blended_forces[i] =
+                        self.forces_n[i] + fraction * (self.trial_forces[i] - self.forces_n[i]);
+                }
+                Self::modal_response(
+                    &self.shapes,
+                    count,
+                    modes,
+                    &self.blended_forces,
+                    &mut self.trial_modal,
+                    &mut self.trial_displacements,
+                );
+                let trial_energy =
+                    self.energy(count, modes, &self.trial_modal, &self.trial_displacements);
+                // Round-off in Π near the minimum must not reject a converging step.
+                if trial_energy <= energy + 1e-13 * energy.abs() || fraction < 1e-6 {
+                    self.forces_n[..count].copy_from_slice(&self.blended_forces[..count]);
+                    self.modal[..modes].copy_from_slice(&self.trial_modal[..modes]);
+                    self.displacements_m[..count]
+                        .copy_from_slice(&self.trial_displacements[..count]);
+                    energy = trial_energy;
+                    break;
+                }
+                fraction *= 0.5;
+            }
+            self.previous_active[..size].copy_from_slice(&self.active[..size]);
+            previous_size = size;
+        }
+        false
+    }
+}
+
+/// The lowest eigenfrequency of the modes with a spring `w_i k` at every point in contact at
+/// rest, rad/s, by inverse iteration (`iterations` solves). `omega` are the modes' angular
+/// frequencies. Allocation-free: it works in the static solver's buffers.
+pub fn linearised_fundamental(
+    points: &ContactPoints,
+    omega: &[f64],
+    modes: usize,
+    solver: &mut StaticSolver,
+    iterations: usize,
+) -> f64 {
+    // The springs in contact at rest and their Woodbury matrix I + D G^s_AA D.
+    let mut size = 0;
+    for i in 0..points.len() {
+        if points.rest_forces_n[i] > 0.0 {
+            solver.active[size] = i;
+            solver.roots[size] = points.springs_n_m[i].sqrt();
+            size += 1;
+        }
+    }
+    for row in 0..size {
+        let i = solver.active[row];
+        for column in 0..=row {
+            let j = solver.active[column];
+            let dot: f64 = points.shape(i)[..modes]
+                .iter()
+                .zip(&points.shape(j)[..modes])
+                .map(|(a, b)| a * b)
+                .sum();
+            let value = solver.roots[row] * dot * solver.roots[column]
+                + if row == column { 1.0 } else { 0.0 };
+            solver.matrix[row * size + column] = value;
+            solver.matrix[column * size + row] = value;
+        }
+    }
+    if size > 0
+        && solver
+            .factor
+            .factorise(&solver.matrix[..size * size], size)
+            .is_err()
+    {
+        return f64::NAN;
+    }
+    let x = &mut solver.modal;
+    let product = &mut solver.trial_modal;
+    for k in 0..modes {
+        x[k] = 1.0 / omega[k];
+    }
+    let mut rayleigh = 0.0;
+    for _ in 0..iterations {
+        // v = M x, M = diag(1/ω²); x ← K⁻¹ v = v − Ψ_Aᵀ D (I + D G D)⁻¹ D Ψ_A v.
+        for k in 0..modes {
+            product[k] = x[k] / (omega[k] * omega[k]);
+        }
+        for row in 0..size {
+            let i = solver.active[row];
+            let dot: f64 = points.shape(i)[..modes]
+                .iter()
+                .zip(&product[..modes])
+                .map(|(a, b)| a * b)
+                .sum();
+            solver.solution[row] = solver.roots[row] * dot;
+        }
+        if size > 0 {
+            solver.factor.solve_in_place(&mut solver.solution[..size]);
+        }
+        for k in 0..modes {
+            x[k] = product[k];
+        }
+        for row in 0..size {
+            let i = solver.active[row];
+            let weight = solver.roots[row] * solver.solution[row];
+            for (value, psi) in x[..modes].iter_mut().zip(points.shape(i)) {
+                *value -= weight * psi;
+            }
+        }
+        // Rayleigh quotient xᵀ K x / xᵀ M x, K x = x + Ψ_Aᵀ C Ψ_A x.
+        let mut stiffness = x[..modes].iter().map(|v| v * v).sum::<f64>();
+        for row in 0..size {
+            let i = solver.active[row];
+            let dot: f64 = points.shape(i)[..modes]
+                .iter()
+                .zip(&x[..modes])
+                .map(|(a, b)| a * b)
+                .sum();
+            stiffness += solver.roots[row] * solver.roots[row] * dot * dot;
+        }
+        let mass: f64 = (0..modes)
+            .map(|k| x[k] * x[k] / (omega[k] * omega[k]))
+            .sum();
+        rayleigh = stiffness / mass;
+        let norm = x[..modes].iter().map(|v| v * v).sum::<f64>().sqrt();
+        for value in &mut x[..modes] {
+            *value /= norm;
+        }
+    }
+    rayleigh.sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_small_ldl_agrees_with_the_general_one() {
+        let n = 5;
+        let mut general = vec![0.0; n * n];
+        let mut small = [[0.0; SMALL]; SMALL];
+        for i in 0..SMALL {
+            small[i][i] = 1.0;
+        }
+        for i in 0..n {
+            for j in 0..=i {
+                let value = if i == j {
+                    3.0 + i as f64
+                } else {
+                    0.3 / (1 + i + j) as f64
+                };
+                general[i * n + j] = value;
+                small[i][j] = value;
+            }
+        }
+        let rhs = [1.0, -2.0, 0.5, 3.0, -1.5];
+        let mut x = rhs.to_vec();
+        let mut y = [0.0; SMALL];
+        y[..n].copy_from_slice(&rhs);
+        ldl_solve_in_place(&mut general, n, &mut x, &mut [0.0; 5]);
+        ldl_solve_small(&mut small, &mut y);
+        for i in 0..n {
+            assert!((x[i] - y[i]).abs() < 1e-14);
+        }
+        assert!(y[n..].iter().all(|&v| v == 0.0));
+    }
+
+    #[test]
+    fn ldl_solves_a_known_system() {
+        // [[4,2,0],[2,5,1],[0,1,3]] x = [2, 7, 7] has x = [0, 1, 2]; lower triangle only.
+        let mut matrix = [4.0, 0.0, 0.0, 2.0, 5.0, 0.0, 0.0, 1.0, 3.0];
+        let mut x = [2.0, 7.0, 7.0];
+        let mut scratch = [0.0; 3];
+        ldl_solve_in_place(&mut matrix, 3, &mut x, &mut scratch);
+        for (value, expected) in x.iter().zip([0.0, 1.0, 2.0]) {
+            assert!((value - expected).abs() < 1e-14, "{value}");
+        }
+    }
+}
