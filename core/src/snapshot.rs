@@ -25,6 +25,8 @@ use crate::bowed::instrument::BOW_HISTORY_SAMPLES;
 use crate::bowed::BowedInstrument;
 use crate::newton::NewtonStats;
 use crate::tanpura::fd::FdString;
+use crate::tanpura::modal::ModalString;
+use crate::tanpura::tier_string::TierString;
 
 /// String nodes a snapshot holds (the seed's grid has 201).
 pub const MAX_STRING_NODES: usize = 256;
@@ -89,6 +91,31 @@ impl<const CAPACITY: usize> BarrierView<CAPACITY> {
     }
 }
 
+/// Intervals of the evenly spaced points at which a modal string is drawn.
+pub const MODAL_VIEW_INTERVALS: usize = 200;
+const _: () = assert!(MODAL_VIEW_INTERVALS < MAX_STRING_NODES);
+
+/// A modal string's contact points `range` as a barrier view: `a_i = h_i − y_i`, so the string
+/// there is `h_i − a_i`.
+fn fill_points<const CAPACITY: usize>(
+    view: &mut BarrierView<CAPACITY>,
+    points: &crate::tanpura::modal::points::ContactPoints,
+    gaps_m: &[f64],
+    range: std::ops::Range<usize>,
+) {
+    let (len, stride) = fit(range.len(), CAPACITY);
+    view.len = len;
+    view.stride = stride;
+    for held in 0..len {
+        let i = range.start + held * stride;
+        let height = points.heights_m[i];
+        view.positions_m[held] = points.positions_m[i] as f32;
+        view.heights_m[held] = height as f32;
+        view.string_m[held] = (height - gaps_m[i]) as f32;
+        view.in_contact[held] = gaps_m[i] > 0.0;
+    }
+}
+
 /// How many of `available` points fit in `capacity`: (held, stride).
 fn fit(available: usize, capacity: usize) -> (usize, usize) {
     let stride = available.div_ceil(capacity).max(1);
@@ -108,7 +135,9 @@ pub struct TanpuraSnapshot {
     pub sample_rate_hz: f64,
     /// Internal steps per output sample (the tier's oversampling).
     pub oversample: u32,
-    /// N, the string grid's intervals.
+    /// True for a modal string (then `grid_intervals` counts its modes).
+    pub modal: bool,
+    /// N, the string grid's intervals (FD), or the number of modes (modal).
     pub grid_intervals: usize,
     /// The Newton iteration cap and tolerance (m) of the string shown.
     pub newton_cap: u32,
@@ -209,6 +238,7 @@ impl TanpuraSnapshot {
         fundamental_hz: 0.0,
         sample_rate_hz: 0.0,
         oversample: 0,
+        modal: false,
         grid_intervals: 0,
         newton_cap: 0,
         newton_tolerance_m: 0.0,
@@ -236,14 +266,56 @@ impl TanpuraSnapshot {
         bowed: BowedView::EMPTY,
     };
 
-    /// Copies the state of `string` (shape, barriers, contact, forces, its Newton statistics).
-    /// Allocation-free.
-    pub fn fill_string(&mut self, string: &FdString) {
+    /// Copies the state of a tier's string (shape, barriers, contact, forces, its Newton
+    /// statistics). Allocation-free.
+    pub fn fill_string(&mut self, string: &TierString) {
+        match string {
+            TierString::FiniteDifference(string) => self.fill_fd_string(string),
+            TierString::Modal(string) => self.fill_modal_string(string),
+        }
+    }
+
+    /// Copies the state of a modal string: the displacement from its modes at
+    /// [`MODAL_VIEW_INTERVALS`] + 1 evenly spaced points, and its bridge and thread points as
+    /// the barriers. `grid_intervals` is the number of modes. Allocation-free.
+    pub fn fill_modal_string(&mut self, string: &ModalString<f32>) {
+        let config = string.config();
+        let length = config.string.length_m;
+        self.modal = true;
+        self.grid_intervals = string.modes().count();
+        self.length_m = length;
+        self.newton_cap = config.newton.max_iterations;
+        self.newton_tolerance_m = config.newton.tolerance_m;
+        self.node_count = MODAL_VIEW_INTERVALS + 1;
+        self.node_stride = 1;
+        for node in 0..=MODAL_VIEW_INTERVALS {
+            let x = length * node as f64 / MODAL_VIEW_INTERVALS as f64;
+            self.node_positions_m[node] = x as f32;
+            self.displacement_m[node] = string.displacement_at_m(x) as f32;
+            self.rest_displacement_m[node] = string.rest_displacement_at_m(x) as f32;
+        }
+        let points = string.points();
+        let gaps = string.gaps_m();
+        let bridge_points = points.bridge_count();
+        fill_points(&mut self.bridge, points, gaps, 0..bridge_points);
+        fill_points(&mut self.thread, points, gaps, bridge_points..points.len());
+        self.max_penetration_m = string.max_penetration_m();
+        self.nut_force_n = string.nut_force_n();
+        self.rest_nut_force_n = string.rest_nut_force_n();
+        self.bridge_force_n = string.bridge_force_n();
+        self.rest_bridge_force_n = string.rest_bridge_force_n();
+        self.shown_newton = *string.newton_stats();
+    }
+
+    /// Copies the state of an FD string (shape, barriers, contact, forces, its Newton
+    /// statistics). Allocation-free.
+    pub fn fill_fd_string(&mut self, string: &FdString) {
         let config = string.config();
         let displacement = string.displacement_m();
         let rest = string.rest_displacement_m();
         let spacing_m = string.operator().spacing_m();
         let (count, stride) = fit(displacement.len(), MAX_STRING_NODES);
+        self.modal = false;
         self.grid_intervals = config.intervals;
         self.length_m = config.string.length_m;
         self.newton_cap = config.newton.max_iterations;
@@ -341,7 +413,97 @@ pub(crate) mod tests {
     use crate::tanpura::TanpuraVoice;
 
     /// Every field of `snapshot` that `fill_string` wrote equals the string's own accessors.
-    pub(crate) fn assert_snapshot_is_string(snapshot: &TanpuraSnapshot, string: &FdString) {
+    pub(crate) fn assert_snapshot_is_string(snapshot: &TanpuraSnapshot, string: &TierString) {
+        match string {
+            TierString::FiniteDifference(string) => assert_snapshot_is_fd_string(snapshot, string),
+            TierString::Modal(string) => assert_snapshot_is_modal_string(snapshot, string),
+        }
+    }
+
+    pub(crate) fn assert_snapshot_is_modal_string(
+        snapshot: &TanpuraSnapshot,
+        string: &ModalString<f32>,
+    ) {
+        let config = string.config();
+        assert!(snapshot.modal);
+        assert_eq!(snapshot.grid_intervals, string.modes().count());
+        assert_eq!(snapshot.node_count, MODAL_VIEW_INTERVALS + 1);
+        assert_eq!(snapshot.newton_cap, config.newton.max_iterations);
+        for node in 0..snapshot.node_count {
+            let x = config.string.length_m * node as f64 / MODAL_VIEW_INTERVALS as f64;
+            assert_eq!(snapshot.node_positions_m[node], x as f32);
+            assert_eq!(
+                snapshot.displacement_m[node],
+                string.displacement_at_m(x) as f32
+            );
+            assert_eq!(
+                snapshot.rest_displacement_m[node],
+                string.rest_displacement_at_m(x) as f32
+            );
+        }
+        let points = string.points();
+        let gaps = string.gaps_m();
+        let bridge = points.bridge_count();
+        assert_eq!(snapshot.bridge.len, bridge);
+        assert_eq!(snapshot.thread.len, points.len() - bridge);
+        for i in 0..points.len() {
+            let (view, held) = if i < bridge {
+                (&snapshot.bridge as &dyn PointView, i)
+            } else {
+                (&snapshot.thread as &dyn PointView, i - bridge)
+            };
+            let (position, height, string_m, contact) = view.point(held);
+            assert_eq!(position, points.positions_m[i] as f32);
+            assert_eq!(height, points.heights_m[i] as f32);
+            assert_eq!(string_m, (points.heights_m[i] - gaps[i]) as f32);
+            assert_eq!(contact, gaps[i] > 0.0);
+        }
+        assert_eq!(snapshot.nut_force_n, string.nut_force_n());
+        assert_eq!(snapshot.bridge_force_n, string.bridge_force_n());
+        assert_eq!(snapshot.shown_newton, *string.newton_stats());
+    }
+
+    /// One point of a barrier view, whatever its capacity.
+    trait PointView {
+        fn point(&self, i: usize) -> (f32, f32, f32, bool);
+    }
+
+    impl<const CAPACITY: usize> PointView for BarrierView<CAPACITY> {
+        fn point(&self, i: usize) -> (f32, f32, f32, bool) {
+            (
+                self.positions_m[i],
+                self.heights_m[i],
+                self.string_m[i],
+                self.in_contact[i],
+            )
+        }
+    }
+
+    #[test]
+    fn snapshot_of_a_ringing_modal_string_equals_its_state() {
+        use crate::tanpura::modal::ModalStringConfig;
+        let mut string = ModalString::<f32>::new(ModalStringConfig::REFERENCE);
+        string.pluck(&Pluck::default());
+        let mut snapshot = TanpuraSnapshot::default();
+        let mut contacts_seen = 0;
+        for _ in 0..12 {
+            for _ in 0..40 {
+                string.step();
+            }
+            snapshot.fill_modal_string(&string);
+            assert_snapshot_is_modal_string(&snapshot, &string);
+            contacts_seen += snapshot.bridge.contact_count() + snapshot.thread.contact_count();
+        }
+        assert!(contacts_seen > 0, "the string touches bridge or thread");
+        string.settle_to_rest();
+        snapshot.fill_modal_string(&string);
+        assert!(snapshot.thread.contact_count() > 0, "resting on the thread");
+        // The drawn rest shape passes through the resting points' contact.
+        let top = snapshot.thread.len / 2;
+        assert!((snapshot.thread.heights_m[top] - snapshot.thread.string_m[top]).abs() < 20e-6);
+    }
+
+    pub(crate) fn assert_snapshot_is_fd_string(snapshot: &TanpuraSnapshot, string: &FdString) {
         let config = string.config();
         let y = string.displacement_m();
         let rest = string.rest_displacement_m();
@@ -406,15 +568,15 @@ pub(crate) mod tests {
             for _ in 0..150 {
                 string.step();
             }
-            snapshot.fill_string(&string);
-            assert_snapshot_is_string(&snapshot, &string);
+            snapshot.fill_fd_string(&string);
+            assert_snapshot_is_fd_string(&snapshot, &string);
             contacts_seen += snapshot.bridge.contact_count() + snapshot.thread.contact_count();
         }
         assert!(contacts_seen > 0, "the string touches bridge or thread");
         // A string resting on bridge and thread touches the thread (rest state).
         string.settle_to_rest();
-        snapshot.fill_string(&string);
-        assert_snapshot_is_string(&snapshot, &string);
+        snapshot.fill_fd_string(&string);
+        assert_snapshot_is_fd_string(&snapshot, &string);
         assert!(snapshot.thread.contact_count() > 0);
     }
 
@@ -429,7 +591,7 @@ pub(crate) mod tests {
         config.intervals = 400;
         let string = FdString::new(config);
         let mut snapshot = TanpuraSnapshot::default();
-        snapshot.fill_string(&string);
+        snapshot.fill_fd_string(&string);
         assert_eq!((snapshot.node_count, snapshot.node_stride), (201, 2));
         let y = string.displacement_m();
         for held in 0..snapshot.node_count {
@@ -507,7 +669,7 @@ pub(crate) mod tests {
         assert_eq!(snapshot.fundamental_hz, hz);
         assert_eq!(snapshot.active_voices, 1);
         assert_eq!(snapshot.sample_rate_hz, rate);
-        let expected_oversample = (1.0 / (lone.string().config().time_step_s * rate)).round();
+        let expected_oversample = (1.0 / (lone.string().time_step_s() * rate)).round();
         assert_eq!(f64::from(snapshot.oversample), expected_oversample);
 
         let mut history = OutputHistory::default();

@@ -1,8 +1,9 @@
 //! The tanpura's audio path allocates nothing: 10 000 output samples of the four-string
-//! instrument (40 000 string steps at 4× oversampling, with plucks and a retune in between)
-//! under a counting global allocator.
+//! instrument at every quality tier (modal and FD, with plucks and a retune in between) under a
+//! counting global allocator.
 
 use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{FirstString, Tanpura, VoiceSettings};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -37,7 +38,16 @@ static GLOBAL: CountingAllocator = CountingAllocator;
 
 #[test]
 fn ten_thousand_samples_of_the_four_string_tanpura_allocate_nothing() {
-    let settings = VoiceSettings::default();
+    for quality in Quality::ALL {
+        four_strings_allocate_nothing(quality);
+    }
+}
+
+fn four_strings_allocate_nothing(quality: Quality) {
+    let settings = VoiceSettings {
+        quality,
+        ..VoiceSettings::default()
+    };
     let mut tanpura = Tanpura::new(&settings, 146.8, 44_100.0);
     let mut retuned = settings;
     retuned.thread_position_m = 0.041;
@@ -58,6 +68,7 @@ fn ten_thousand_samples_of_the_four_string_tanpura_allocate_nothing() {
     COUNTING.store(false, Ordering::SeqCst);
 
     assert!(sum.is_finite());
-    assert_eq!(tanpura.newton_stats().steps, 4 * 4 * 10_000);
-    assert_eq!(ALLOCATIONS.load(Ordering::SeqCst), 0);
+    let steps = 4 * quality.oversample() as u64 * 10_000;
+    assert_eq!(tanpura.newton_stats().steps, steps, "{quality:?}");
+    assert_eq!(ALLOCATIONS.load(Ordering::SeqCst), 0, "{quality:?}");
 }

@@ -15,6 +15,7 @@ const SECONDS: f64 = 0.03;
 struct Outcome {
     peak_n: f64,
     tension_n: f64,
+    unit_round_off: f64,
     worst_energy_growth: f64,
     cap_hits: u64,
     steps: u64,
@@ -41,7 +42,8 @@ fn run(settings: &VoiceSettings, pluck: &Pluck, sample_rate: f64) -> Outcome {
     let stats = voice.newton_stats();
     Outcome {
         peak_n: peak,
-        tension_n: voice.string().config().string.tension_n,
+        tension_n: voice.string().parameters().tension_n,
+        unit_round_off: voice.string().unit_round_off(),
         worst_energy_growth: worst_growth,
         cap_hits: stats.cap_hits,
         steps: stats.steps,
@@ -60,8 +62,10 @@ fn check(name: &str, outcome: &Outcome, conservative: bool) {
         outcome.tension_n
     );
     // Energy never grows: each step's H(n+1) − H(n) stays at round-off relative to H(0)
-    // (the losses only remove energy; the lossless scheme conserves it).
-    let allowed = if conservative { 1e-11 } else { 1e-12 };
+    // (the losses only remove energy; the lossless scheme conserves it). The modal tiers carry
+    // their modes in f32: their H moves by a few units of f32 round-off per step.
+    let f64_allowed: f64 = if conservative { 1e-11 } else { 1e-12 };
+    let allowed = f64_allowed.max(16.0 * outcome.unit_round_off);
     assert!(
         outcome.worst_energy_growth <= allowed,
         "{name}: energy grew by {:e} of H(0)",
@@ -308,14 +312,17 @@ fn changing_only_the_losses_keeps_the_tuning_a_full_retune_would_give() {
         let mut changed = TanpuraVoice::new(&before, 44_100.0);
         changed.set_settings(&after);
         let fresh = TanpuraVoice::new(&after, 44_100.0);
+        let (changed, fresh) = (changed.string(), fresh.string());
         assert_eq!(
-            changed.string().config(),
-            fresh.string().config(),
+            changed.as_fd().map(|string| string.config()),
+            fresh.as_fd().map(|string| string.config()),
             "{quality:?}"
         );
         assert_eq!(
-            changed.string().rest_nut_force_n(),
-            fresh.string().rest_nut_force_n()
+            changed.as_modal().map(|string| string.config()),
+            fresh.as_modal().map(|string| string.config()),
+            "{quality:?}"
         );
+        assert_eq!(changed.rest_nut_force_n(), fresh.rest_nut_force_n());
     }
 }

@@ -5,7 +5,12 @@
 
 use javari_core::analysis::{band_power, power_spectrum, spectral_centroid_hz};
 use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
+
+/// The signature must hold for both discretisations: the seed's FD scheme (reference) and the
+/// modal scheme of the default tier (live).
+const TIERS: [Quality; 2] = [Quality::Live, Quality::Reference];
 
 const SAMPLE_RATE: f64 = 44_100.0;
 const WINDOW: usize = 8192;
@@ -33,31 +38,45 @@ fn nut_force_evolution(settings: &VoiceSettings) -> Vec<(f64, f64)> {
 
 #[test]
 fn with_bridge_and_thread_the_formant_centre_falls_and_energy_moves_up() {
-    let evolution = nut_force_evolution(&VoiceSettings::default());
-    for pair in evolution.windows(2) {
+    for quality in TIERS {
+        let evolution = nut_force_evolution(&VoiceSettings {
+            quality,
+            ..VoiceSettings::default()
+        });
+        for pair in evolution.windows(2) {
+            assert!(
+                pair[1].0 < pair[0].0,
+                "{quality:?}: the formant centre must fall: {evolution:?}"
+            );
+        }
+        let (first, last) = (evolution[0].0, evolution[evolution.len() - 1].0);
         assert!(
-            pair[1].0 < pair[0].0,
-            "the formant centre must fall: {evolution:?}"
+            last < 0.6 * first,
+            "{quality:?}: fell from {first} Hz only to {last} Hz"
+        );
+        // The collisions feed the upper partials: their share rises well above the pluck's own.
+        let peak_share = evolution.iter().map(|e| e.1).fold(0.0, f64::max);
+        assert!(
+            peak_share > 1.5 * evolution[0].1,
+            "{quality:?}: {evolution:?}"
         );
     }
-    let (first, last) = (evolution[0].0, evolution[evolution.len() - 1].0);
-    assert!(last < 0.6 * first, "fell from {first} Hz only to {last} Hz");
-    // The collisions feed the upper partials: their share rises well above the pluck's own.
-    let peak_share = evolution.iter().map(|e| e.1).fold(0.0, f64::max);
-    assert!(peak_share > 1.5 * evolution[0].1, "{evolution:?}");
 }
 
 #[test]
 fn without_the_bridge_beyond_the_thread_upper_partials_never_gain_share() {
-    let settings = VoiceSettings {
-        bridge_beyond_thread: false,
-        ..VoiceSettings::default()
-    };
-    let evolution = nut_force_evolution(&settings);
-    for pair in evolution.windows(2) {
-        assert!(
-            pair[1].1 <= pair[0].1,
-            "upper-partial share grew: {evolution:?}"
-        );
+    for quality in TIERS {
+        let settings = VoiceSettings {
+            bridge_beyond_thread: false,
+            quality,
+            ..VoiceSettings::default()
+        };
+        let evolution = nut_force_evolution(&settings);
+        for pair in evolution.windows(2) {
+            assert!(
+                pair[1].1 <= pair[0].1,
+                "{quality:?}: upper-partial share grew: {evolution:?}"
+            );
+        }
     }
 }

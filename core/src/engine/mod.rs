@@ -345,13 +345,8 @@ impl Engine {
         snapshot.active_voices = self.active_voices();
         snapshot.fundamental_hz = shown.fundamental_hz;
         snapshot.sample_rate_hz = self.sample_rate_hz;
-        snapshot.oversample =
-            (1.0 / (string.config().time_step_s * self.sample_rate_hz)).round() as u32;
-        let mut newton = crate::newton::NewtonStats::default();
-        for slot in &self.slots {
-            newton.merge(slot.voice.newton_stats());
-        }
-        snapshot.newton = newton;
+        snapshot.oversample = (1.0 / (string.time_step_s() * self.sample_rate_hz)).round() as u32;
+        snapshot.newton = self.newton_stats();
         // Output = force · level_factor / NEWTONS_AT_FULL_SCALE · gain (`render_segment`).
         let gain = self.output_gain.value();
         snapshot.output_to_force_n = if gain > 0.0 && shown.level_factor > 0.0 {
@@ -375,6 +370,15 @@ impl Engine {
 
     pub fn voice_count(&self) -> usize {
         self.slots.len()
+    }
+
+    /// Newton statistics of every string together, since each string's last reset.
+    pub fn newton_stats(&self) -> crate::newton::NewtonStats {
+        let mut stats = crate::newton::NewtonStats::default();
+        for slot in &self.slots {
+            stats.merge(slot.voice.newton_stats());
+        }
+        stats
     }
 
     /// Number of strings currently computing.

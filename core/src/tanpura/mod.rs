@@ -24,6 +24,7 @@ pub mod instrument;
 pub mod modal;
 pub mod quality;
 pub mod string;
+pub mod tier_string;
 pub mod voice;
 
 pub use instrument::{FirstString, Tanpura};

@@ -1,17 +1,22 @@
-//! Quality tiers: how much of the seed's resolution a tanpura voice spends.
+//! Quality tiers: which discretisation a tanpura voice runs, and at what resolution.
 //!
-//! A tier sets the internal oversampling, the string grid Δx, the barrier grid spacings, the
-//! Newton tolerance and cap, and the solver. Reference is the seed's own discretisation
-//! (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm, Δx_c = 0.15 mm) with a tolerance at
-//! round-off. Every tier solves the same energy-stable scheme (eq. 22) with Newton reduced to the
-//! contact region (`condensed.rs`), so every tier keeps the exact discrete energy balance; the
-//! cheaper tiers only resolve less. The balance is exact only for a converged Newton: a tolerance
-//! of 1e-8 m let the energy of the draft tier grow by 0.3 % per step at k_b = 1e12 N/m² (found by
-//! `tests/tanpura_extremes.rs`), so every tier iterates to 1e-12 m or tighter, and the cap of 30
-//! updates leaves room for the stiffest contact (24 updates at most, measured at k_b = 1e12 on the
-//! draft grid). Coarser tiers get a stiffer EI that keeps their inharmonicity at the reference's
-//! (`tanpura.rs`, `dispersion_compensated_stiffness`). What each tier costs and how far it lands from the reference
-//! is measured by `cargo xtask bench`.
+//! - Draft and Live run the modal scheme (`modal/`, `docs/modal-tanpura.md`): the string's
+//!   eigenmodes advanced by exact two-pole recursions at the output rate (exact partials and decay
+//!   rates, no oversampling, no decimator, no latency), in f32 over the modes, with the contact
+//!   force on a few points of the bridge and thread solved by Newton in f64. Live keeps the modes
+//!   below 20 kHz and a point every millimetre of the bridge and every half millimetre of the
+//!   thread; Draft keeps the modes below 10 kHz with points twice as far apart.
+//! - Studio and Reference run the seed's finite-difference scheme (`fd/`). Reference is the
+//!   seed's own discretisation (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm,
+//!   Δx_c = 0.15 mm) with a tolerance at round-off; Studio halves the oversampling and keeps the
+//!   seed's grids. Studio's EI is raised so that its inharmonicity matches the reference's
+//!   (`voice.rs`, `dispersion_compensated_stiffness`).
+//!
+//! Every tier keeps its scheme's exact discrete energy balance; the balance holds only for a
+//! converged Newton: a tolerance of 1e-8 m let an FD tier's energy grow by 0.3 % per step at
+//! k_b = 1e12 N/m² (found by `tests/tanpura_extremes.rs`), so every tier iterates to 1e-12 m or
+//! tighter, with a cap of 30 updates. What each tier costs and how far it lands from the
+//! reference is measured by `cargo xtask bench`.
 
 use crate::newton::NewtonSettings;
 use crate::tanpura::fd::SolverKind;
@@ -26,9 +31,20 @@ pub enum Quality {
     Reference,
 }
 
-/// The numerical choices of one tier.
+/// The numerical choices of one modal tier.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Tier {
+pub struct ModalTier {
+    /// Modes are kept below this frequency (and below 0.45 of the sample rate), Hz.
+    pub highest_mode_hz: f64,
+    /// Contact point spacing on the bridge and on the thread, m.
+    pub bridge_point_spacing_m: f64,
+    pub thread_point_spacing_m: f64,
+    pub newton: NewtonSettings,
+}
+
+/// The numerical choices of one finite-difference tier.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FdTier {
     /// Internal rate / output rate.
     pub oversample: usize,
     /// N, string grid intervals over the 668 mm string.
@@ -38,6 +54,19 @@ pub struct Tier {
     pub newton: NewtonSettings,
     pub solver: SolverKind,
 }
+
+/// The discretisation of one tier with its resolution.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tier {
+    Modal(ModalTier),
+    FiniteDifference(FdTier),
+}
+
+/// Newton's tolerance and cap in every tier but the reference.
+const TIER_NEWTON: NewtonSettings = NewtonSettings {
+    tolerance_m: 1e-12,
+    max_iterations: 30,
+};
 
 impl Quality {
     pub const ALL: [Quality; 4] = [
@@ -49,44 +78,54 @@ impl Quality {
 
     pub fn tier(self) -> Tier {
         match self {
-            Quality::Draft => Tier {
-                oversample: 1,
-                intervals: 50,
-                barrier_spacing_scale: 4.0,
-                newton: NewtonSettings {
-                    tolerance_m: 1e-12,
-                    max_iterations: 30,
-                },
-                solver: SolverKind::Condensed,
-            },
-            Quality::Live => Tier {
-                oversample: 2,
-                intervals: 100,
-                barrier_spacing_scale: 2.0,
-                newton: NewtonSettings {
-                    tolerance_m: 1e-12,
-                    max_iterations: 30,
-                },
-                solver: SolverKind::Condensed,
-            },
-            Quality::Studio => Tier {
+            Quality::Draft => Tier::Modal(ModalTier {
+                highest_mode_hz: 10_000.0,
+                bridge_point_spacing_m: 2e-3,
+                thread_point_spacing_m: 1e-3,
+                newton: TIER_NEWTON,
+            }),
+            Quality::Live => Tier::Modal(ModalTier {
+                highest_mode_hz: 20_000.0,
+                bridge_point_spacing_m: 1e-3,
+                thread_point_spacing_m: 0.5e-3,
+                newton: TIER_NEWTON,
+            }),
+            Quality::Studio => Tier::FiniteDifference(FdTier {
                 oversample: 2,
                 intervals: 200,
                 barrier_spacing_scale: 1.0,
-                newton: NewtonSettings {
-                    tolerance_m: 1e-12,
-                    max_iterations: 30,
-                },
+                newton: TIER_NEWTON,
                 solver: SolverKind::Condensed,
-            },
-            Quality::Reference => Tier {
+            }),
+            Quality::Reference => Tier::FiniteDifference(FdTier {
                 oversample: 4,
                 intervals: 200,
                 barrier_spacing_scale: 1.0,
                 newton: NewtonSettings::REFERENCE,
                 solver: SolverKind::Condensed,
-            },
+            }),
         }
+    }
+
+    /// The FD tier's numerical choices, `None` for a modal tier.
+    pub fn fd_tier(self) -> Option<FdTier> {
+        match self.tier() {
+            Tier::FiniteDifference(tier) => Some(tier),
+            Tier::Modal(_) => None,
+        }
+    }
+
+    /// The modal tier's numerical choices, `None` for an FD tier.
+    pub fn modal_tier(self) -> Option<ModalTier> {
+        match self.tier() {
+            Tier::Modal(tier) => Some(tier),
+            Tier::FiniteDifference(_) => None,
+        }
+    }
+
+    /// Internal steps per output sample (1 for the modal tiers).
+    pub fn oversample(self) -> usize {
+        self.fd_tier().map_or(1, |tier| tier.oversample)
     }
 
     /// Position in [`Quality::ALL`].
@@ -126,7 +165,7 @@ mod tests {
 
     #[test]
     fn reference_is_the_seed_discretisation() {
-        let tier = Quality::Reference.tier();
+        let tier = Quality::Reference.fd_tier().unwrap();
         assert_eq!(tier.oversample, 4);
         assert_eq!(tier.intervals, 200);
         assert_eq!(tier.barrier_spacing_scale, 1.0);
@@ -134,13 +173,15 @@ mod tests {
     }
 
     #[test]
-    fn tiers_get_cheaper_in_order() {
-        let cost = |q: Quality| {
-            let tier = q.tier();
-            tier.oversample as f64 * tier.intervals as f64 / tier.barrier_spacing_scale.sqrt()
-        };
-        for pair in Quality::ALL.windows(2) {
-            assert!(cost(pair[0]) < cost(pair[1]), "{pair:?}");
-        }
+    fn fast_tiers_are_modal_and_draft_resolves_less_than_live() {
+        let draft = Quality::Draft.modal_tier().unwrap();
+        let live = Quality::Live.modal_tier().unwrap();
+        assert!(draft.highest_mode_hz < live.highest_mode_hz);
+        assert!(draft.bridge_point_spacing_m > live.bridge_point_spacing_m);
+        assert!(draft.thread_point_spacing_m > live.thread_point_spacing_m);
+        assert_eq!(Quality::Live.oversample(), 1);
+        let studio = Quality::Studio.fd_tier().unwrap();
+        let reference = Quality::Reference.fd_tier().unwrap();
+        assert!(studio.oversample < reference.oversample);
     }
 }

@@ -2,26 +2,31 @@
 //!
 //! A voice holds one string per quality tier (`quality.rs`), all built up front, so switching
 //! tiers never allocates; only the selected tier's string is computed, and switching starts it
-//! at rest.
+//! at rest. The draft and live tiers run the modal scheme ([`ModalString`], at the output rate,
+//! no latency), studio and reference the seed's FD scheme ([`FdString`]) at `oversample ×` the
+//! output rate (seed 000: 4 × 44.1 kHz), brought down by a Kaiser-windowed FIR (`decimator.rs`).
 //!
-//! A voice maps musician-facing settings in SI units onto [`FdString`]: the tension follows
+//! A voice maps musician-facing settings in SI units onto either string: the tension follows
 //! the pitch, `T = ρA (2 L_s f)² / (1 + B)` with the speaking length `L_s` from the thread (or the
 //! bridge crest) to the nut and the stiff-string correction `B = π² EI / (T L_s²)` (solved by a
-//! fixed-point pass); the scheme runs at `oversample ×` the output rate (seed 000: 4 × 44.1 kHz)
-//! and a Kaiser-windowed FIR (`decimator.rs`) brings it down. The output is the pickup mix of the
-//! nut force (eq. 13) and the bridge force (eq. 12) minus their values at rest, so a silent string
-//! outputs exactly 0 and carries no DC.
+//! fixed-point pass), then two passes on the linearised fundamental of the string resting on
+//! bridge and thread. The studio tier's EI is raised so that its dispersion matches the
+//! reference's; the reference keeps the seed's EI; the modal tiers have no dispersion. The output is the
+//! pickup mix of the nut force (eq. 13) and the bridge force (eq. 12) minus their values at
+//! rest, so a silent string outputs exactly 0 and carries no DC.
 //!
 //! A voice whose vibration energy has fallen below [`SLEEP_ENERGY_J`] (−86 dB below a typical
 //! pluck) is put exactly at rest and sleeps: no computation at all until its next pluck, once the
-//! decimator's tail has been flushed.
+//! decimator's tail (FD tiers) has been flushed.
 
 use super::excitation::Pluck;
 use super::fd::decimator::Decimator;
 use super::fd::{FdString, FdStringConfig};
 use super::geometry::ThreadSettings;
+use super::modal::{ModalString, ModalStringConfig};
 use super::quality::Quality;
 use super::string::StringParameters;
+use super::tier_string::TierString;
 use crate::newton::NewtonStats;
 use std::fmt;
 
@@ -184,15 +189,14 @@ impl VoiceSettings {
         }
     }
 
-    /// The string configuration these settings describe at `output_sample_rate_hz`, at the
-    /// settings' own quality tier.
-    pub fn string_config(&self, output_sample_rate_hz: f64) -> FdStringConfig {
-        self.string_config_at(self.quality, output_sample_rate_hz)
-    }
-
-    /// The string configuration at a given quality tier.
-    pub fn string_config_at(&self, quality: Quality, output_sample_rate_hz: f64) -> FdStringConfig {
-        let tier = quality.tier();
+    /// The FD string configuration these settings describe at an FD tier and
+    /// `output_sample_rate_hz`; `None` for a modal tier.
+    pub fn fd_config_at(
+        &self,
+        quality: Quality,
+        output_sample_rate_hz: f64,
+    ) -> Option<FdStringConfig> {
+        let tier = quality.fd_tier()?;
         let mut config = FdStringConfig::REFERENCE;
         config.intervals = tier.intervals;
         config.time_step_s = 1.0 / (output_sample_rate_hz * tier.oversample as f64);
@@ -204,19 +208,56 @@ impl VoiceSettings {
             spacing_m: ThreadSettings::SEED.spacing_m * tier.barrier_spacing_scale,
             ..ThreadSettings::SEED
         });
-        config.string.gamma_per_s = self.gamma_per_s;
-        config.string.eta_s = self.eta_s;
-        config.string.tension_n =
-            tension_for_pitch_n(&config, config.speaking_start_m(), self.fundamental_hz);
+        config.string = self.string_parameters(config.speaking_start_m());
         config.string.bending_stiffness_n_m2 = dispersion_compensated_stiffness(
-            &config,
-            quality,
+            &config.string,
+            config.speaking_start_m(),
+            config.string.length_m / config.intervals as f64,
+            config.time_step_s,
             self.fundamental_hz,
             output_sample_rate_hz,
         );
+        if quality == Quality::Reference {
+            config.string.bending_stiffness_n_m2 = StringParameters::SEED.bending_stiffness_n_m2;
+        }
         config.newton = tier.newton;
         config.solver = tier.solver;
-        config
+        Some(config)
+    }
+
+    /// The modal string configuration these settings describe at a modal tier and
+    /// `output_sample_rate_hz`; `None` for an FD tier. The modal scheme has no dispersion, so the
+    /// string keeps its own EI.
+    pub fn modal_config_at(
+        &self,
+        quality: Quality,
+        output_sample_rate_hz: f64,
+    ) -> Option<ModalStringConfig> {
+        let tier = quality.modal_tier()?;
+        let mut config = ModalStringConfig::REFERENCE;
+        config.time_step_s = 1.0 / output_sample_rate_hz;
+        config.highest_mode_hz = tier.highest_mode_hz;
+        config.bridge_point_spacing_m = tier.bridge_point_spacing_m;
+        config.thread_point_spacing_m = tier.thread_point_spacing_m;
+        config.bridge.stiffness_n_m2 = self.bridge_stiffness_n_m2;
+        config.bridge.beyond_thread = self.bridge_beyond_thread;
+        config.thread = self.thread_enabled.then_some(ThreadSettings {
+            position_m: self.thread_position_m,
+            ..ThreadSettings::SEED
+        });
+        config.string = self.string_parameters(config.speaking_start_m());
+        config.newton = tier.newton;
+        Some(config)
+    }
+
+    /// The seed's string with these settings' losses and the tension that puts the speaking
+    /// length from `speaking_start_m` at the pitch (before the contact-aware tuning of the voice).
+    fn string_parameters(&self, speaking_start_m: f64) -> StringParameters {
+        let mut string = StringParameters::SEED;
+        string.gamma_per_s = self.gamma_per_s;
+        string.eta_s = self.eta_s;
+        string.tension_n = tension_for_pitch_n(&string, speaking_start_m, self.fundamental_hz);
+        string
     }
 }
 
@@ -224,23 +265,22 @@ impl VoiceSettings {
 /// `fundamental_hz`: `f = (1/2L_s) √(T/ρA) √(1 + B)`, `B = π² EI/(T L_s²)`, solved for T by
 /// fixed point.
 pub fn tension_for_pitch_n(
-    config: &FdStringConfig,
+    string: &StringParameters,
     speaking_start_m: f64,
     fundamental_hz: f64,
 ) -> f64 {
-    let p = config.string;
-    let speaking = p.length_m - speaking_start_m;
-    let ideal = p.linear_density_kg_m * (2.0 * speaking * fundamental_hz).powi(2);
+    let speaking = string.length_m - speaking_start_m;
+    let ideal = string.linear_density_kg_m * (2.0 * speaking * fundamental_hz).powi(2);
     let mut tension = ideal;
     for _ in 0..8 {
-        let b = std::f64::consts::PI.powi(2) * p.bending_stiffness_n_m2
+        let b = std::f64::consts::PI.powi(2) * string.bending_stiffness_n_m2
             / (tension * speaking * speaking);
         tension = ideal / (1.0 + b);
     }
     tension
 }
 
-/// Relative flattening of partial n, per n², that the scheme's discretisation causes at a
+/// Relative flattening of partial n, per n², that the FD scheme's discretisation causes at a
 /// fundamental `fundamental_hz` over the speaking length `speaking_m`: `(πΔx/L_s)²/24` from the
 /// second difference in space and `(2πf₀Δt)²/12` from the trapezoidal rule in time (both
 /// lower the frequencies; the leading terms of their Taylor series).
@@ -255,49 +295,48 @@ fn dispersion_per_n_squared(
     space + time
 }
 
-/// The bending stiffness that gives a tier the same n² inharmonicity as the reference tier.
+/// The bending stiffness that gives an FD tier the same n² inharmonicity as the reference tier.
 ///
 /// Stiffness raises partial n by `B n²/2` (relative, `B = π² EI/(T L_s²)`), the discretisation
 /// lowers it by `c n²` (see [`dispersion_per_n_squared`]). A coarser tier has a larger `c`; raising
 /// its `B` by `2(c_tier − c_reference)` cancels the difference to leading order, so the first ten
-/// partials of every tier stay close to the reference's. The reference keeps the seed's EI.
+/// partials of every FD tier stay close to the reference's. The reference keeps the seed's EI
+/// (its own dispersion flattens the tenth partial by about 2.6 cents against the continuous
+/// string, which the modal tiers reproduce exactly).
 fn dispersion_compensated_stiffness(
-    config: &FdStringConfig,
-    quality: Quality,
+    string: &StringParameters,
+    speaking_start_m: f64,
+    spacing_m: f64,
+    time_step_s: f64,
     fundamental_hz: f64,
     output_sample_rate_hz: f64,
 ) -> f64 {
-    let p = config.string;
-    let speaking = p.length_m - config.speaking_start_m();
-    let tier_dispersion = dispersion_per_n_squared(
-        p.length_m / config.intervals as f64,
-        config.time_step_s,
-        speaking,
-        fundamental_hz,
-    );
-    let reference = Quality::Reference.tier();
+    let speaking = string.length_m - speaking_start_m;
+    let reference = Quality::Reference
+        .fd_tier()
+        .expect("the reference tier is FD");
     let reference_dispersion = dispersion_per_n_squared(
-        p.length_m / reference.intervals as f64,
+        string.length_m / reference.intervals as f64,
         1.0 / (output_sample_rate_hz * reference.oversample as f64),
         speaking,
         fundamental_hz,
     );
-    if quality == Quality::Reference {
-        return p.bending_stiffness_n_m2;
-    }
+    let dispersion = dispersion_per_n_squared(spacing_m, time_step_s, speaking, fundamental_hz);
     let pi2 = std::f64::consts::PI.powi(2);
-    let inharmonicity = pi2 * p.bending_stiffness_n_m2 / (p.tension_n * speaking * speaking)
-        + 2.0 * (tier_dispersion - reference_dispersion);
-    inharmonicity * p.tension_n * speaking * speaking / pi2
+    let tension_l2 = string.tension_n * speaking * speaking;
+    let inharmonicity = pi2 * string.bending_stiffness_n_m2 / tension_l2
+        + 2.0 * (dispersion - reference_dispersion);
+    inharmonicity * tension_l2 / pi2
 }
 
-/// One tanpura string with its oversampling and decimation; allocation-free after `new`.
+/// One tanpura string with its tier's discretisation (and the FD tiers' oversampling and
+/// decimation); allocation-free after `new`.
 #[derive(Debug, Clone)]
 pub struct TanpuraVoice {
     settings: VoiceSettings,
     output_sample_rate_hz: f64,
     /// One string per quality tier, indexed by [`Quality::index`].
-    strings: Vec<FdString>,
+    strings: Vec<TierString>,
     /// The settings each tier's string was last configured for.
     configured: Vec<Option<VoiceSettings>>,
     /// One decimator per oversampling factor, built up front.
@@ -312,13 +351,19 @@ impl TanpuraVoice {
     /// A silent voice at rest. Invalid settings are clamped. Allocates every tier's string.
     pub fn new(settings: &VoiceSettings, output_sample_rate_hz: f64) -> Self {
         let settings = settings.clamped();
+        // Built with a thread so that its points exist if it is switched on later.
+        let mut build = settings;
+        build.thread_enabled = true;
         let strings = Quality::ALL
             .iter()
             .map(|&quality| {
-                // Built with a thread so that its grid exists if it is switched on later.
-                let mut build = settings;
-                build.thread_enabled = true;
-                FdString::new(build.string_config_at(quality, output_sample_rate_hz))
+                if let Some(config) = build.modal_config_at(quality, output_sample_rate_hz) {
+                    TierString::Modal(ModalString::new(config))
+                } else if let Some(config) = build.fd_config_at(quality, output_sample_rate_hz) {
+                    TierString::FiniteDifference(FdString::new(config))
+                } else {
+                    unreachable!("every tier is modal or FD")
+                }
             })
             .collect();
         let decimators = (1..=MAX_OVERSAMPLE).map(Decimator::new).collect();
@@ -337,32 +382,54 @@ impl TanpuraVoice {
         voice
     }
 
-    fn string_mut(&mut self) -> &mut FdString {
+    fn string_mut(&mut self) -> &mut TierString {
         &mut self.strings[self.settings.quality.index()]
     }
 
     /// The string of the selected tier.
-    pub fn string(&self) -> &FdString {
+    pub fn string(&self) -> &TierString {
         &self.strings[self.settings.quality.index()]
     }
 
     fn oversample(&self) -> usize {
-        self.settings.quality.tier().oversample
+        self.settings.quality.oversample()
+    }
+
+    /// Applies a configuration with the given tension to the selected tier's string.
+    fn apply_config(&mut self, tension_n: Option<f64>) {
+        let settings = self.settings;
+        let rate = self.output_sample_rate_hz;
+        match &mut self.strings[settings.quality.index()] {
+            TierString::FiniteDifference(string) => {
+                if let Some(mut config) = settings.fd_config_at(settings.quality, rate) {
+                    if let Some(tension) = tension_n {
+                        config.string.tension_n = tension;
+                    }
+                    string.set_config(config);
+                }
+            }
+            TierString::Modal(string) => {
+                if let Some(mut config) = settings.modal_config_at(settings.quality, rate) {
+                    if let Some(tension) = tension_n {
+                        config.string.tension_n = tension;
+                    }
+                    string.set_config(config);
+                }
+            }
+        }
     }
 
     /// Configures the selected tier's string for the settings and tunes it: the tension is
     /// scaled until the linearised fundamental of the string resting on bridge and thread
-    /// ([`FdString::linearised_fundamental_hz`]) is the requested pitch. The contact
-    /// geometry makes the speaking length differ from "thread to nut" by up to 1 %, which
-    /// would be 18 cents; two passes of `T ← T (f / f_lin)²` bring it under 0.1 cent.
+    /// (`linearised_fundamental_hz` of either discretisation) is the requested pitch. The
+    /// contact geometry makes the speaking length differ from "thread to nut" by up to 1 %,
+    /// which would be 18 cents; two passes of `T ← T (f / f_lin)²` bring it under 0.1 cent.
     fn configure_string(&mut self) {
         let settings = self.settings;
         let index = settings.quality.index();
         if self.configured[index] == Some(settings) {
             return;
         }
-        let mut config = settings.string_config(self.output_sample_rate_hz);
-        let string = &mut self.strings[index];
         if let Some(previous) = self.configured[index] {
             // The pickup mix does not touch the string at all.
             let pickup_only = VoiceSettings {
@@ -373,9 +440,9 @@ impl TanpuraVoice {
                 self.configured[index] = Some(settings);
                 return;
             }
-            // The losses change the step matrix but not the rest state the tuning is computed
-            // on: keep the tuned tension and skip the inverse iterations (the engine moves γ
-            // and η every control tick while they glide).
+            // The losses change the step but not the rest state the tuning is computed on:
+            // keep the tuned tension and skip the inverse iterations (the engine moves γ and η
+            // every control tick while they glide).
             let losses_and_pickup = VoiceSettings {
                 gamma_per_s: settings.gamma_per_s,
                 eta_s: settings.eta_s,
@@ -383,21 +450,22 @@ impl TanpuraVoice {
                 ..previous
             };
             if losses_and_pickup == settings {
-                config.string.tension_n = string.config().string.tension_n;
-                string.set_config(config);
+                let tension = self.strings[index].parameters().tension_n;
+                self.apply_config(Some(tension));
                 self.configured[index] = Some(settings);
                 return;
             }
         }
-        string.set_config(config);
+        self.apply_config(None);
         for _ in 0..TUNING_PASSES {
+            let string = &mut self.strings[index];
             let linearised = string.linearised_fundamental_hz();
             if !(linearised.is_finite() && linearised > 0.0) {
                 break;
             }
             let ratio = settings.fundamental_hz / linearised;
-            config.string.tension_n *= ratio * ratio;
-            string.set_config(config);
+            let tension = string.parameters().tension_n * ratio * ratio;
+            self.apply_config(Some(tension));
         }
         self.configured[index] = Some(settings);
     }
@@ -445,11 +513,7 @@ impl TanpuraVoice {
 
     /// The pickup at the internal rate, N: the nut/bridge mix minus its value at rest.
     pub fn pickup_internal_n(&self) -> f64 {
-        let string = self.string();
-        let w = self.settings.nut_pickup_weight;
-        let nut = string.nut_force_n() - string.rest_nut_force_n();
-        let bridge = string.bridge_force_n() - string.rest_bridge_force_n();
-        w * nut + (1.0 - w) * bridge
+        self.string().pickup_n(self.settings.nut_pickup_weight)
     }
 
     /// One output-rate sample of the pickup signal, N.
@@ -469,22 +533,31 @@ impl TanpuraVoice {
             }
             return output as f32;
         }
-        let mut output = 0.0;
-        for _ in 0..oversample {
+        let output = if oversample == 1 {
+            // The modal tiers run at the output rate: no decimator, no latency.
             self.string_mut().step();
-            let pickup = self.pickup_internal_n();
-            if let Some(y) = self.decimators[oversample - 1].push(pickup) {
-                output = y;
+            self.pickup_internal_n()
+        } else {
+            let mut output = 0.0;
+            for _ in 0..oversample {
+                self.string_mut().step();
+                let pickup = self.pickup_internal_n();
+                if let Some(y) = self.decimators[oversample - 1].push(pickup) {
+                    output = y;
+                }
             }
-        }
+            output
+        };
         self.samples_since_sleep_check += 1;
         if self.samples_since_sleep_check >= SLEEP_CHECK_INTERVAL {
             self.samples_since_sleep_check = 0;
             if self.string().vibration_energy_j() < SLEEP_ENERGY_J {
                 self.string_mut().settle_to_rest();
                 self.sleeping = true;
-                let decimator = &self.decimators[oversample - 1];
-                self.tail_remaining = decimator.taps().len() / oversample + 1;
+                if oversample > 1 {
+                    let decimator = &self.decimators[oversample - 1];
+                    self.tail_remaining = decimator.taps().len() / oversample + 1;
+                }
             }
         }
         output as f32
@@ -516,8 +589,12 @@ impl TanpuraVoice {
         self.string().newton_stats()
     }
 
-    /// Output latency of the decimation filter, samples at the output rate.
+    /// Output latency, samples at the output rate: the decimation filter's delay for the FD
+    /// tiers, none for the modal tiers.
     pub fn latency_samples(&self) -> f64 {
-        self.decimators[self.oversample() - 1].delay_output_samples()
+        match self.oversample() {
+            1 => 0.0,
+            oversample => self.decimators[oversample - 1].delay_output_samples(),
+        }
     }
 }

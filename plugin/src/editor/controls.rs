@@ -267,10 +267,21 @@ fn quality_indicator(
     } else {
         Color32::from_rgb(110, 210, 120)
     };
+    let discretisation = if snapshot.modal {
+        format!(
+            "The string runs in {} exact modes at the output rate, with the contact on a few points of bridge and thread",
+            snapshot.grid_intervals
+        )
+    } else {
+        format!(
+            "The string runs at {}× the output rate on a grid of N = {} intervals",
+            snapshot.oversample, snapshot.grid_intervals
+        )
+    };
     ui.label(format!("Quality: {}", params.quality))
         .on_hover_text(format!(
-            "The string runs at {}× the output rate on a grid of N = {} intervals; Newton stops at {:.0e} m or after {} updates per step.",
-            snapshot.oversample, snapshot.grid_intervals, snapshot.newton_tolerance_m, snapshot.newton_cap
+            "{discretisation}; Newton stops at {:.0e} m or after {} updates per step.",
+            snapshot.newton_tolerance_m, snapshot.newton_cap
         ));
     ui.label(RichText::new(format!("load {:.0} %", 100.0 * load)).color(load_colour))
         .on_hover_text(

@@ -39,7 +39,7 @@ use points::{grid_points, ContactPoints};
 use solve::{linearised_fundamental, ContactStep, StaticSolver};
 use std::f64::consts::PI;
 
-const _: () = assert!(MODE_CAPACITY % LANE_PADDING == 0);
+const _: () = assert!(MODE_CAPACITY.is_multiple_of(LANE_PADDING));
 
 /// Largest fingertip the finger's points have room for, m.
 const MAX_FINGER_WIDTH_M: f64 = 0.040;
@@ -254,7 +254,8 @@ impl<T: Real> ModalString<T> {
     /// when the new configuration needs more contact points than the string was built for.
     pub fn set_config(&mut self, config: ModalStringConfig) -> bool {
         if config.point_capacity() > self.points.capacity()
-            || !(config.time_step_s > 0.0)
+            || config.time_step_s.is_nan()
+            || config.time_step_s <= 0.0
             || config.string.length_m != self.config.string.length_m
         {
             return false;
@@ -539,25 +540,32 @@ impl<T: Real> ModalString<T> {
         self.contact.corrections_m.fill(0.0);
     }
 
+    /// `y_s(x) + Σ_k Ψ_k(x) c_k` for modal coefficients `c_k`, with the sines by recurrence
+    /// (no scratch, so `&self`).
+    fn shape_sum(&self, x_m: f64, coefficient: impl Fn(usize) -> f64) -> f64 {
+        let length = self.config.string.length_m;
+        let line = self.config.string.left_support_m * (1.0 - x_m / length);
+        let theta = PI * x_m / length;
+        let twice_cos = 2.0 * theta.cos();
+        let (mut previous, mut current) = (0.0, theta.sin());
+        let mut sum = 0.0;
+        for k in 0..self.modes.count() {
+            sum += current * self.modes.inverse_root_stiffness[k] * coefficient(k);
+            let next = twice_cos * current - previous;
+            previous = current;
+            current = next;
+        }
+        line + sum
+    }
+
     /// The rest shape's displacement at `x_m`, m.
-    pub fn rest_displacement_at_m(&mut self, x_m: f64) -> f64 {
-        self.modes.shape_row(x_m, &mut self.row);
-        let line = self.config.string.left_support_m * (1.0 - x_m / self.config.string.length_m);
-        line + self
-            .row
-            .iter()
-            .zip(&self.rest_modal)
-            .map(|(psi, r)| psi * r)
-            .sum::<f64>()
+    pub fn rest_displacement_at_m(&self, x_m: f64) -> f64 {
+        self.shape_sum(x_m, |k| self.rest_modal[k])
     }
 
     /// The string's displacement at `x_m` now, m: `y_s(x) + Σ_k Ψ_k(x) (r_rest,k + r̃_k)`.
-    pub fn displacement_at_m(&mut self, x_m: f64) -> f64 {
-        self.modes.shape_row(x_m, &mut self.row);
-        let line = self.config.string.left_support_m * (1.0 - x_m / self.config.string.length_m);
-        line + (0..self.modes.count())
-            .map(|k| self.row[k] * (self.rest_modal[k] + self.modal[k].to_f64()))
-            .sum::<f64>()
+    pub fn displacement_at_m(&self, x_m: f64) -> f64 {
+        self.shape_sum(x_m, |k| self.rest_modal[k] + self.modal[k].to_f64())
     }
 
     /// The seed's finger pluck (section 5): press the finger until the string is in static
@@ -739,6 +747,12 @@ impl<T: Real> ModalString<T> {
 
     pub fn points(&self) -> &ContactPoints {
         &self.points
+    }
+
+    /// The modal state about the rest state: `r̃_k` and `p_k` of the kept modes (section 4).
+    pub fn modal_state(&self) -> (&[T], &[T]) {
+        let count = self.modes.count();
+        (&self.modal[..count], &self.velocity[..count])
     }
 
     /// The gaps a_i of the points now, m (positive: the string penetrates).

@@ -94,7 +94,9 @@ impl ModeSet {
             let stiffness =
                 half_length * (string.tension_n * k2 + string.bending_stiffness_n_m2 * k2 * k2);
             let omega = (stiffness / mass).sqrt();
-            if !(omega / (2.0 * PI) < limit_hz) && index > 0 {
+            // NaN (a degenerate string) stops the count like a mode above the limit.
+            let below_limit = omega / (2.0 * PI) < limit_hz;
+            if !below_limit && index > 0 {
                 break;
             }
             let decay = 0.5 * string.gamma_per_s + 0.5 * string.eta_s * omega * omega;

@@ -613,6 +613,7 @@ impl StaticSolver {
         );
         let mut energy = self.energy(count, modes, &self.modal, &self.displacements_m);
         let mut previous_size = usize::MAX;
+        let mut last_step_full = false;
         for _ in 0..STATIC_MAX_ITERATIONS {
             // The contact set of the current iterate.
             let mut size = 0;
@@ -623,13 +624,17 @@ impl StaticSolver {
                     size += 1;
                 }
             }
-            let settled = size == previous_size
-                && self.active[..size] == self.previous_active[..size]
-                && (0..count).all(|i| {
-                    let expected = self.springs_n_m[i]
-                        * (self.free_gaps_m[i] - self.displacements_m[i]).max(0.0);
-                    (self.forces_n[i] - expected).abs() <= 1e-12 * expected.abs().max(1e-9)
-                });
+            // The problem is piecewise quadratic: a full Newton step that lands in the contact
+            // set it was computed for is its exact minimiser.
+            let same_set =
+                size == previous_size && self.active[..size] == self.previous_active[..size];
+            let settled = same_set
+                && (last_step_full
+                    || (0..count).all(|i| {
+                        let expected = self.springs_n_m[i]
+                            * (self.free_gaps_m[i] - self.displacements_m[i]).max(0.0);
+                        (self.forces_n[i] - expected).abs() <= 1e-12 * expected.abs().max(1e-9)
+                    }));
             if settled {
                 return true;
             }
@@ -683,6 +688,7 @@ impl StaticSolver {
                     self.energy(count, modes, &self.trial_modal, &self.trial_displacements);
                 // Round-off in Π near the minimum must not reject a converging step.
                 if trial_energy <= energy + 1e-13 * energy.abs() || fraction < 1e-6 {
+                    last_step_full = fraction == 1.0;
                     self.forces_n[..count].copy_from_slice(&self.blended_forces[..count]);
                     self.modal[..modes].copy_from_slice(&self.trial_modal[..modes]);
                     self.displacements_m[..count]
@@ -764,9 +770,7 @@ pub fn linearised_fundamental(
         if size > 0 {
             solver.factor.solve_in_place(&mut solver.solution[..size]);
         }
-        for k in 0..modes {
-            x[k] = product[k];
-        }
+        x[..modes].copy_from_slice(&product[..modes]);
         for row in 0..size {
             let i = solver.active[row];
             let weight = solver.roots[row] * solver.solution[row];
