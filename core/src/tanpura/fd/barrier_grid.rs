@@ -19,6 +19,7 @@
 
 use crate::banded::SymmetricBanded;
 use crate::tanpura::contact::{potential_density, HuntCrossley};
+use crate::tanpura::fd::kernels::{Kernels, StencilSegment};
 
 /// One barrier: its points, shape, contact law and per-step work arrays.
 #[derive(Debug, Clone)]
@@ -36,6 +37,12 @@ pub struct BarrierGrid {
     heights_m: Vec<f64>,
     stencil_first_node: Vec<usize>,
     stencil_weights: Vec<[f64; 4]>,
+    /// The same weights by column (`weight_columns[j][i] = stencil_weights[i][j]`), and the runs
+    /// of consecutive points that share a stencil: the layout of the vectorised gap pass.
+    weight_columns: [Vec<f64>; 4],
+    segments: Vec<StencilSegment>,
+    segment_count: usize,
+    kernels: Kernels,
     /// The free stencil: first node in `1..=N−4` and weights with fixed nodes zeroed.
     free_first_node: Vec<usize>,
     free_weights: Vec<[f64; 4]>,
@@ -52,6 +59,12 @@ pub struct BarrierGrid {
     candidate_nodes: (usize, usize),
     /// max_i Σ_j |w_ij|: bounds |s̃_i| ≤ lebesgue · max_m |s_m| over the stencil nodes.
     lebesgue: f64,
+}
+
+/// The interpolated step `w · s[first..first + 4]` of a free stencil.
+#[inline(always)]
+fn step_at(weights: &[f64; 4], step: &[f64], first: usize) -> f64 {
+    dot4(weights, &step[first..])
 }
 
 /// `w · v[..4]`, the four-point stencil sum (one bounds check, the products in order).
@@ -112,6 +125,10 @@ impl BarrierGrid {
             heights_m: vec![0.0; capacity],
             stencil_first_node: vec![0; capacity],
             stencil_weights: vec![[0.0; 4]; capacity],
+            weight_columns: std::array::from_fn(|_| vec![0.0; capacity]),
+            segments: vec![StencilSegment::default(); capacity],
+            segment_count: 0,
+            kernels: Kernels::detect(),
             free_first_node: vec![1; capacity],
             free_weights: vec![[0.0; 4]; capacity],
             gaps_m: vec![0.0; capacity],
@@ -153,12 +170,33 @@ impl BarrierGrid {
             let (first, weights) = lagrange_stencil(x / string_spacing_m, self.string_intervals);
             self.stencil_first_node[i] = first;
             self.stencil_weights[i] = weights;
+            for (column, weight) in self.weight_columns.iter_mut().zip(weights) {
+                column[i] = weight;
+            }
             let (free_first, free_weights) = free_stencil(first, weights, self.string_intervals);
             self.free_first_node[i] = free_first;
             self.free_weights[i] = free_weights;
             self.lebesgue = self
                 .lebesgue
                 .max(weights.iter().map(|w| w.abs()).sum::<f64>());
+        }
+        // Points are placed in order, so each stencil's points form one run.
+        self.segment_count = 0;
+        for i in 0..count {
+            let first_node = self.stencil_first_node[i];
+            match self.segment_count.checked_sub(1) {
+                Some(last) if self.segments[last].first_node == first_node => {
+                    self.segments[last].end = i + 1;
+                }
+                _ => {
+                    self.segments[self.segment_count] = StencilSegment {
+                        first_node,
+                        start: i,
+                        end: i + 1,
+                    };
+                    self.segment_count += 1;
+                }
+            }
         }
     }
 
@@ -253,31 +291,26 @@ impl BarrierGrid {
     /// are only meaningful for the candidates, and only after an evaluation.
     pub fn begin_step(&mut self, displacement: &[f64], margin_m: f64) {
         let count = self.count;
+        let [w0, w1, w2, w3] = &self.weight_columns;
+        self.kernels.barrier_gaps(
+            &self.heights_m[..count],
+            [&w0[..count], &w1[..count], &w2[..count], &w3[..count]],
+            &self.segments[..self.segment_count],
+            displacement,
+            &mut self.gaps_m[..count],
+        );
         let mut candidate_count = 0;
-        let (mut lowest, mut highest) = (usize::MAX, 0);
-        let points = self.heights_m[..count]
-            .iter()
-            .zip(&self.stencil_first_node[..count])
-            .zip(&self.stencil_weights[..count])
-            .zip(&mut self.gaps_m[..count]);
-        for (i, (((height, &first), weights), gap_out)) in points.enumerate() {
-            let gap = height - dot4(weights, &displacement[first..]);
-            *gap_out = gap;
+        for (i, gap) in self.gaps_m[..count].iter().enumerate() {
             // Branch-free compaction: the slot is written always, kept only for candidates.
             self.candidates[candidate_count] = i;
-            let candidate = gap > -margin_m;
-            candidate_count += candidate as usize;
-            if candidate {
-                let free_first = self.free_first_node[i];
-                lowest = lowest.min(free_first);
-                highest = highest.max(free_first + 3);
-            }
+            candidate_count += (*gap > -margin_m) as usize;
         }
         self.candidate_count = candidate_count;
-        self.candidate_nodes = if candidate_count > 0 {
-            (lowest, highest)
-        } else {
-            (1, 0)
+        // Points are in order along the string, so their free stencils are too.
+        self.candidate_nodes = match self.candidates[..candidate_count] {
+            [] => (1, 0),
+            [first, .., last] => (self.free_first_node[first], self.free_first_node[last] + 3),
+            [only] => (self.free_first_node[only], self.free_first_node[only] + 3),
         };
     }
 
@@ -319,41 +352,46 @@ impl BarrierGrid {
         }
     }
 
-    /// Evaluates the candidates at the step `step` (as [`BarrierGrid::evaluate`]) and adds, in
-    /// the same pass, `I* f̃` into the full-node vector `node_forces` and the lower triangle of
-    /// `I* C I` into the dense row-major `size × size` block `jacobian`, whose row r is string
-    /// node `first_node + r`; the block must hold [`BarrierGrid::candidate_node_range`].
-    /// The fused loop of the condensed Newton update (`condensed.rs`).
-    pub fn evaluate_into_block(
-        &mut self,
+    /// Evaluates the contact law of every candidate at the step `step` and adds, in the same
+    /// pass, `I* f̃` into the full-node vector `node_forces` and `I* C I` into the banded block
+    /// `band` (`band[r][k]` is the entry of string nodes `first_node + r` and
+    /// `first_node + r − k`, the lower triangle), which must hold
+    /// [`BarrierGrid::candidate_node_range`]. The per-point results are not kept (the
+    /// accepted step's come from [`BarrierGrid::evaluate_forces_into`]): the fused loop of the
+    /// condensed Newton update (`condensed.rs`).
+    pub fn evaluate_into_band(
+        &self,
         step: &[f64],
         node_forces: &mut [f64],
-        jacobian: &mut [f64],
-        size: usize,
+        band: &mut [[f64; 4]],
         first_node: usize,
     ) {
+        let scale = self.transpose_scale;
         for &i in &self.candidates[..self.candidate_count] {
             let first = self.free_first_node[i];
             let w = &self.free_weights[i];
-            let point_step = dot4(w, &step[first..]);
-            let contact = self.law.midpoint_force(self.gaps_m[i], point_step);
-            self.steps_m[i] = point_step;
-            self.forces[i] = contact.force;
-            self.jacobian[i] = contact.stiffness;
-            self.squared_gap_changes[i] = contact.squared_gap_change;
+            let contact = self
+                .law
+                .midpoint_force(self.gaps_m[i], step_at(w, step, first));
             if contact.stiffness == 0.0 && contact.force == 0.0 {
                 continue;
             }
-            let force = self.transpose_scale * contact.force;
-            let stiffness = self.transpose_scale * contact.stiffness;
-            let nodes = &mut node_forces[first..first + 4];
-            let row = first - first_node;
+            let force = scale * contact.force;
+            let nodes: &mut [f64; 4] = (&mut node_forces[first..first + 4])
+                .try_into()
+                .expect("four nodes");
+            for (node, weight) in nodes.iter_mut().zip(w) {
+                *node += weight * force;
+            }
+            // Rows first..first + 4 of I* C I: row j holds c w_j w_k at offset j − k ≤ j.
+            let rows: &mut [[f64; 4]; 4] = (&mut band[first - first_node..][..4])
+                .try_into()
+                .expect("four rows");
+            let c = scale * contact.stiffness;
             for j in 0..4 {
-                nodes[j] += w[j] * force;
-                let scaled = stiffness * w[j];
-                let entries = &mut jacobian[(row + j) * size + row..][..j + 1];
-                for (entry, weight) in entries.iter_mut().zip(w) {
-                    *entry += scaled * weight;
+                let scaled = c * w[j];
+                for k in 0..=j {
+                    rows[j][j - k] += scaled * w[k];
                 }
             }
         }

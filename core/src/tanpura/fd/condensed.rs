@@ -51,7 +51,10 @@ pub struct ContactCondensation {
     active_first: usize,
     active_size: usize,
     active_schur: Vec<f64>,
-    /// S' + (Σ I* C I)_C'C' for the current iterate (lower triangle), then its LDLᵀ factors.
+    /// (Σ I* C I)_C'C' for the current iterate, banded: `band[r][k]` couples the block's nodes
+    /// r and r − k (the contact stencils span four nodes).
+    band: Vec<[f64; 4]>,
+    /// S' + the band (lower triangle), then its LDLᵀ factors.
     jacobian: Vec<f64>,
     /// s_lin on C.
     predictor: Vec<f64>,
@@ -78,6 +81,7 @@ impl ContactCondensation {
             active_first: first_node,
             active_size: 0,
             active_schur: vec![0.0; size * size],
+            band: vec![[0.0; 4]; size],
             jacobian: vec![0.0; size * size],
             predictor: vec![0.0; size],
             previous_correction: vec![0.0; size],
@@ -247,26 +251,29 @@ impl ContactCondensation {
         self.predictor.iter().fold(0.0, |a, s| a.max(s.abs()))
     }
 
-    /// The Jacobian buffer of the active block, reset to S', for barriers to add the lower
-    /// triangle of their `I* C I` block into; with the block's first node and size.
-    pub fn jacobian_reset_to_schur(&mut self) -> (&mut [f64], usize, usize) {
-        let cells = self.active_size * self.active_size;
-        self.jacobian[..cells].copy_from_slice(&self.active_schur[..cells]);
-        (
-            &mut self.jacobian[..cells],
-            self.active_size,
-            self.active_first,
-        )
+    /// The contact Jacobian band of the active block, zeroed, for barriers to add their
+    /// `I* C I` into; with the block's first node and size.
+    pub fn contact_band_reset(&mut self) -> (&mut [[f64; 4]], usize, usize) {
+        let band = &mut self.band[..self.active_size];
+        band.fill([0.0; 4]);
+        (band, self.active_first, self.active_size)
     }
 
     /// One Newton update on the active block: with the contact forces `contact` (full-node,
-    /// I* f̃) already evaluated at `step` and the Jacobian assembled, solves and applies the
-    /// update to `step` on the block. Returns ‖δ‖∞, or None when the Jacobian is not positive
-    /// definite.
+    /// I* f̃) and the contact band already evaluated at `step`, forms the Jacobian
+    /// `S' + I* C I`, solves and applies the update to `step` on the block. Returns ‖δ‖∞, or
+    /// None when the Jacobian is not positive definite.
     pub fn update(&mut self, step: &mut [f64], contact: &[f64]) -> Option<f64> {
         let size = self.active_size;
         let first = self.active_first;
         let offset = first - self.first_node;
+        let cells = size * size;
+        self.jacobian[..cells].copy_from_slice(&self.active_schur[..cells]);
+        for (row, entries) in self.band[..size].iter().enumerate() {
+            for (k, value) in entries.iter().enumerate().take(row + 1) {
+                self.jacobian[row * size + row - k] += value;
+            }
+        }
         // R = S' (s − s_lin) − f on the block; `scratch` holds s − s_lin.
         let block_step = &step[first..first + size];
         for ((difference, s), predictor) in self.scratch[..size]

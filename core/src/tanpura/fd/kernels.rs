@@ -6,7 +6,11 @@
 //!   `r_m = 2qⁿ_m − (Δt²/2ρA) g_m` with the restoring force `g = K y − b` of `operator.rs`
 //!   (`g_m = −T c_m + EI (c_{m−1} − 2c_m + c_{m+1})/Δx²`, `c_m = δxx y_m`, `c_0 = c_N = 0`);
 //! - the contact correction `s ← s + f_j A⁻¹ e_j` (`condensed.rs`), one per forced node;
-//! - the state update `yⁿ⁺¹ = yⁿ + s`, `qⁿ⁺¹ = s − qⁿ` (eq. 16) with the finiteness check.
+//! - the state update `yⁿ⁺¹ = yⁿ + s`, `qⁿ⁺¹ = s − qⁿ` (eq. 16) with the finiteness check;
+//!
+//! and one over every barrier point (`barrier_grid.rs`): the gaps `a_i = y_barrier(x_i) − (I y)_i`
+//! before the step (eq. 17), computed run by run of points that share a stencil, so that the four
+//! node values are broadcast and the weights read by column.
 //!
 //! Each is a [`pulp::WithSimd`] kernel: [`pulp::Arch`] picks AVX-512, AVX2+FMA or scalar code
 //! once, so the generic x86-64 binary uses the widest unit present, as the modal tier's
@@ -17,6 +21,14 @@
 //! (deterministic renders).
 
 use pulp::{Arch, Simd, WithSimd};
+
+/// A run `start..end` of barrier points whose interpolation stencils all start at `first_node`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct StencilSegment {
+    pub first_node: usize,
+    pub start: usize,
+    pub end: usize,
+}
 
 /// The instruction set chosen once per string, and the kernels dispatched on it.
 #[derive(Debug, Clone, Copy)]
@@ -80,6 +92,25 @@ impl Kernels {
         });
     }
 
+    /// `gaps_i = heights_i − Σ_j weights[j]_i · values[first_node + j]` for the points of every
+    /// segment (full-node `values`).
+    pub fn barrier_gaps(
+        &self,
+        heights: &[f64],
+        weights: [&[f64]; 4],
+        segments: &[StencilSegment],
+        values: &[f64],
+        gaps: &mut [f64],
+    ) {
+        self.arch.dispatch(BarrierGaps {
+            heights,
+            weights,
+            segments,
+            values,
+            gaps,
+        });
+    }
+
     /// `y ← y + s`, `q ← s − q` on the interior nodes 1..N−1; returns whether every `s` was
     /// finite.
     pub fn advance_state(
@@ -116,6 +147,54 @@ impl WithSimd for Axpy<'_> {
         }
         for (y, x) in y_tail.iter_mut().zip(x_tail) {
             *y += self.a * x;
+        }
+    }
+}
+
+struct BarrierGaps<'a> {
+    heights: &'a [f64],
+    weights: [&'a [f64]; 4],
+    segments: &'a [StencilSegment],
+    values: &'a [f64],
+    gaps: &'a mut [f64],
+}
+
+impl WithSimd for BarrierGaps<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        for segment in self.segments {
+            let range = segment.start..segment.end;
+            let y = &self.values[segment.first_node..segment.first_node + 4];
+            let (h_lanes, h_tail) = S::as_simd_f64s(&self.heights[range.clone()]);
+            let (w0_lanes, w0_tail) = S::as_simd_f64s(&self.weights[0][range.clone()]);
+            let (w1_lanes, w1_tail) = S::as_simd_f64s(&self.weights[1][range.clone()]);
+            let (w2_lanes, w2_tail) = S::as_simd_f64s(&self.weights[2][range.clone()]);
+            let (w3_lanes, w3_tail) = S::as_simd_f64s(&self.weights[3][range.clone()]);
+            let (out_lanes, out_tail) = S::as_mut_simd_f64s(&mut self.gaps[range]);
+            let (y0, y1) = (simd.splat_f64s(y[0]), simd.splat_f64s(y[1]));
+            let (y2, y3) = (simd.splat_f64s(y[2]), simd.splat_f64s(y[3]));
+            let lanes = out_lanes
+                .iter_mut()
+                .zip(h_lanes)
+                .zip(w0_lanes.iter().zip(w1_lanes))
+                .zip(w2_lanes.iter().zip(w3_lanes));
+            for (((out, h), (w0, w1)), (w2, w3)) in lanes {
+                let mut sum = simd.mul_f64s(*w0, y0);
+                sum = simd.mul_add_e_f64s(*w1, y1, sum);
+                sum = simd.mul_add_e_f64s(*w2, y2, sum);
+                sum = simd.mul_add_e_f64s(*w3, y3, sum);
+                *out = simd.sub_f64s(*h, sum);
+            }
+            let tail = out_tail
+                .iter_mut()
+                .zip(h_tail)
+                .zip(w0_tail.iter().zip(w1_tail))
+                .zip(w2_tail.iter().zip(w3_tail));
+            for (((out, h), (w0, w1)), (w2, w3)) in tail {
+                *out = h - (w0 * y[0] + w1 * y[1] + w2 * y[2] + w3 * y[3]);
+            }
         }
     }
 }

@@ -157,11 +157,11 @@ impl StepSolver {
     /// One Newton update on the active contact block only (see `condensed.rs`).
     fn condensed_update(&mut self) -> Option<f64> {
         let condensation = self.condensation.as_mut()?;
-        let (jacobian, size, first) = condensation.jacobian_reset_to_schur();
+        let (band, first, size) = condensation.contact_band_reset();
         self.contact[first..first + size].fill(0.0);
-        for barrier in [&mut self.bridge, &mut self.thread] {
+        for barrier in [&self.bridge, &self.thread] {
             if barrier.is_active() {
-                barrier.evaluate_into_block(&self.step, &mut self.contact, jacobian, size, first);
+                barrier.evaluate_into_band(&self.step, &mut self.contact, band, first);
             }
         }
         condensation.update(&mut self.step, &self.contact)
