@@ -113,6 +113,12 @@ pub struct BandedLdlt {
     factors: SymmetricBanded,
     /// 1/D, so that solves multiply instead of divide.
     inverse_diagonal: Vec<f64>,
+    /// For half-bandwidth 2 (the string's step matrix, solved every time step), the factors
+    /// once more in the order the two sweeps read them: `forward[r] = (L[r][r−1], L[r][r−2])`
+    /// and `backward[r] = (1/D[r], L[r+1][r], L[r+2][r])` (zero beyond the matrix). Empty for
+    /// other bandwidths.
+    forward: Vec<[f64; 2]>,
+    backward: Vec<[f64; 3]>,
 }
 
 /// The matrix handed to [`BandedLdlt::factorise`] was not positive definite.
@@ -124,9 +130,12 @@ pub struct NotPositiveDefinite {
 impl BandedLdlt {
     /// Room for factorising matrices of this shape. Allocates.
     pub fn with_shape(size: usize, half_bandwidth: usize) -> Self {
+        let pentadiagonal_size = if half_bandwidth == 2 { size } else { 0 };
         Self {
             factors: SymmetricBanded::zeros(size, half_bandwidth),
             inverse_diagonal: vec![0.0; size],
+            forward: vec![[0.0; 2]; pentadiagonal_size],
+            backward: vec![[0.0; 3]; pentadiagonal_size],
         }
     }
 
@@ -160,6 +169,23 @@ impl BandedLdlt {
             }
             band[row * width] = diagonal;
             self.inverse_diagonal[row] = 1.0 / diagonal;
+        }
+        if w == 2 {
+            let entry = |row: usize, offset: usize| {
+                if row < size {
+                    self.factors.band[row * 3 + offset]
+                } else {
+                    0.0
+                }
+            };
+            for row in 0..size {
+                self.forward[row] = [entry(row, 1), entry(row, 2)];
+                self.backward[row] = [
+                    self.inverse_diagonal[row],
+                    entry(row + 1, 1),
+                    entry(row + 2, 2),
+                ];
+            }
         }
         Ok(())
     }
@@ -212,35 +238,28 @@ impl BandedLdlt {
 }
 
 impl BandedLdlt {
-    /// The same solve for half-bandwidth 2 (the string's step matrix, solved every time step),
-    /// with the two previous values carried in registers: the sweeps are a serial dependency
-    /// chain, so loop overhead, not arithmetic, is what costs.
+    /// The same solve for half-bandwidth 2 (the string's step matrix, solved every time step).
+    /// The sweeps are a serial dependency chain, so the coefficients come from the two
+    /// sweep-ordered arrays, the diagonal scaling rides in the backward sweep, and each row
+    /// subtracts the older neighbour first, so that only one multiply and one subtraction wait
+    /// for the previous row.
     fn solve_pentadiagonal(&self, solution: &mut [f64]) {
         let size = self.factors.size;
-        let band = &self.factors.band[..size * 3];
         let solution = &mut solution[..size];
         let (mut previous, mut before_previous) = (0.0, 0.0);
-        for (x, entries) in solution.iter_mut().zip(band.chunks_exact(3)) {
-            let value = *x - entries[1] * previous - entries[2] * before_previous;
+        for (x, [l1, l2]) in solution.iter_mut().zip(&self.forward) {
+            let value = (*x - l2 * before_previous) - l1 * previous;
             *x = value;
             before_previous = previous;
             previous = value;
         }
-        for (x, inverse) in solution.iter_mut().zip(&self.inverse_diagonal) {
-            *x *= inverse;
-        }
-        // Backward: x[r] −= L[r+1][r] x[r+1] + L[r+2][r] x[r+2], where L[r+1][r] is row r + 1's
-        // offset-1 entry and L[r+2][r] row r + 2's offset-2 entry: carried up as rows are done.
+        // Backward: x[r] = z[r]/D[r] − L[r+1][r] x[r+1] − L[r+2][r] x[r+2].
         let (mut next, mut after_next) = (0.0, 0.0);
-        let (mut coupling_next, mut coupling_after_next, mut pending_offset_two) = (0.0, 0.0, 0.0);
-        for (row, x) in solution.iter_mut().enumerate().rev() {
-            let value = *x - coupling_next * next - coupling_after_next * after_next;
+        for (x, [inverse, u1, u2]) in solution.iter_mut().zip(&self.backward).rev() {
+            let value = (*x * inverse - u2 * after_next) - u1 * next;
             *x = value;
             after_next = next;
             next = value;
-            coupling_after_next = pending_offset_two;
-            pending_offset_two = band[row * 3 + 2];
-            coupling_next = band[row * 3 + 1];
         }
     }
 }

@@ -11,10 +11,15 @@
 //!
 //! Stencils that reach the fixed end nodes read their boundary values (the lowered support);
 //! forces and Jacobian entries at fixed nodes are dropped, since those nodes do not move and
-//! their step is zero, which costs nothing in the energy balance.
+//! their step is zero, which costs nothing in the energy balance. Each point therefore keeps a
+//! second, "free" copy of its stencil for everything that acts on the step `s` (zero at the
+//! fixed nodes): the weights of fixed nodes set to zero and the four nodes shifted inside
+//! `1..=N−1`, so that the per-iteration loops need no boundary tests (`s̃ = I s` is unchanged,
+//! since the dropped terms multiply zeros).
 
 use crate::banded::SymmetricBanded;
 use crate::tanpura::contact::{potential_density, HuntCrossley};
+use crate::tanpura::fd::kernels::{Kernels, StencilSegment};
 
 /// One barrier: its points, shape, contact law and per-step work arrays.
 #[derive(Debug, Clone)]
@@ -32,6 +37,15 @@ pub struct BarrierGrid {
     heights_m: Vec<f64>,
     stencil_first_node: Vec<usize>,
     stencil_weights: Vec<[f64; 4]>,
+    /// The same weights by column (`weight_columns[j][i] = stencil_weights[i][j]`), and the runs
+    /// of consecutive points that share a stencil: the layout of the vectorised gap pass.
+    weight_columns: [Vec<f64>; 4],
+    segments: Vec<StencilSegment>,
+    segment_count: usize,
+    kernels: Kernels,
+    /// The free stencil: first node in `1..=N−4` and weights with fixed nodes zeroed.
+    free_first_node: Vec<usize>,
+    free_weights: Vec<[f64; 4]>,
     /// a_i = y_barrier − ỹ^n: positive means the string penetrates the barrier.
     gaps_m: Vec<f64>,
     steps_m: Vec<f64>,
@@ -41,8 +55,40 @@ pub struct BarrierGrid {
     /// Points that may touch during the current step (see [`BarrierGrid::begin_step`]).
     candidates: Vec<usize>,
     candidate_count: usize,
+    /// The free nodes the candidates' stencils reach, `first..=last` (empty: first > last).
+    candidate_nodes: (usize, usize),
     /// max_i Σ_j |w_ij|: bounds |s̃_i| ≤ lebesgue · max_m |s_m| over the stencil nodes.
     lebesgue: f64,
+}
+
+/// The interpolated step `w · s[first..first + 4]` of a free stencil.
+#[inline(always)]
+fn step_at(weights: &[f64; 4], step: &[f64], first: usize) -> f64 {
+    dot4(weights, &step[first..])
+}
+
+/// `w · v[..4]`, the four-point stencil sum (one bounds check, the products in order).
+#[inline(always)]
+fn dot4(weights: &[f64; 4], values: &[f64]) -> f64 {
+    let v = &values[..4];
+    weights[0] * v[0] + weights[1] * v[1] + weights[2] * v[2] + weights[3] * v[3]
+}
+
+/// The stencil `first, weights` restricted to the free nodes `1..=N−1` of a string of
+/// `intervals` intervals: weights on fixed nodes zeroed, the four nodes shifted inside.
+/// Needs N ≥ 5, so that four free nodes exist.
+fn free_stencil(first: usize, weights: [f64; 4], intervals: usize) -> (usize, [f64; 4]) {
+    debug_assert!(intervals >= 5, "a free stencil needs four free nodes");
+    let last_free = intervals - 1;
+    let free_first = first.clamp(1, last_free.saturating_sub(3).max(1));
+    let mut free = [0.0; 4];
+    for (j, weight) in weights.iter().enumerate() {
+        let node = first + j;
+        if (1..=last_free).contains(&node) && node >= free_first && node < free_first + 4 {
+            free[node - free_first] = *weight;
+        }
+    }
+    (free_first, free)
 }
 
 /// Cubic Lagrange weights on the nodes `first..first + 4` for the point `x` (in units of Δx).
@@ -79,6 +125,12 @@ impl BarrierGrid {
             heights_m: vec![0.0; capacity],
             stencil_first_node: vec![0; capacity],
             stencil_weights: vec![[0.0; 4]; capacity],
+            weight_columns: std::array::from_fn(|_| vec![0.0; capacity]),
+            segments: vec![StencilSegment::default(); capacity],
+            segment_count: 0,
+            kernels: Kernels::detect(),
+            free_first_node: vec![1; capacity],
+            free_weights: vec![[0.0; 4]; capacity],
             gaps_m: vec![0.0; capacity],
             steps_m: vec![0.0; capacity],
             forces: vec![0.0; capacity],
@@ -86,6 +138,7 @@ impl BarrierGrid {
             squared_gap_changes: vec![0.0; capacity],
             candidates: vec![0; capacity],
             candidate_count: 0,
+            candidate_nodes: (1, 0),
             lebesgue: 1.0,
         }
     }
@@ -117,9 +170,33 @@ impl BarrierGrid {
             let (first, weights) = lagrange_stencil(x / string_spacing_m, self.string_intervals);
             self.stencil_first_node[i] = first;
             self.stencil_weights[i] = weights;
+            for (column, weight) in self.weight_columns.iter_mut().zip(weights) {
+                column[i] = weight;
+            }
+            let (free_first, free_weights) = free_stencil(first, weights, self.string_intervals);
+            self.free_first_node[i] = free_first;
+            self.free_weights[i] = free_weights;
             self.lebesgue = self
                 .lebesgue
                 .max(weights.iter().map(|w| w.abs()).sum::<f64>());
+        }
+        // Points are placed in order, so each stencil's points form one run.
+        self.segment_count = 0;
+        for i in 0..count {
+            let first_node = self.stencil_first_node[i];
+            match self.segment_count.checked_sub(1) {
+                Some(last) if self.segments[last].first_node == first_node => {
+                    self.segments[last].end = i + 1;
+                }
+                _ => {
+                    self.segments[self.segment_count] = StencilSegment {
+                        first_node,
+                        start: i,
+                        end: i + 1,
+                    };
+                    self.segment_count += 1;
+                }
+            }
         }
     }
 
@@ -191,12 +268,16 @@ impl BarrierGrid {
     /// `(I v)_i`: the full-node vector `values` interpolated at point `i`.
     #[inline]
     pub fn interpolate(&self, values: &[f64], i: usize) -> f64 {
-        let first = self.stencil_first_node[i];
-        let w = &self.stencil_weights[i];
-        w[0] * values[first]
-            + w[1] * values[first + 1]
-            + w[2] * values[first + 2]
-            + w[3] * values[first + 3]
+        dot4(
+            &self.stencil_weights[i],
+            &values[self.stencil_first_node[i]..],
+        )
+    }
+
+    /// `(I s)_i` for a step `s` that is zero at the fixed nodes, through the free stencil.
+    #[inline]
+    fn interpolate_step(&self, step: &[f64], i: usize) -> f64 {
+        dot4(&self.free_weights[i], &step[self.free_first_node[i]..])
     }
 
     /// Records the gaps `a_i = y_barrier(x_i) − ỹ_i` for the displacement before the step and
@@ -204,20 +285,40 @@ impl BarrierGrid {
     /// stays out of contact for any step with `|s̃_i| < margin_m`, so the caller must check
     /// that bound on its accepted step ([`BarrierGrid::lebesgue_constant`]) or pass an infinite
     /// margin.
+    ///
+    /// Also records the free nodes the candidates' stencils reach
+    /// ([`BarrierGrid::candidate_node_range`]). The per-point results of the last evaluation
+    /// are only meaningful for the candidates, and only after an evaluation.
     pub fn begin_step(&mut self, displacement: &[f64], margin_m: f64) {
-        self.candidate_count = 0;
-        for i in 0..self.count {
-            let gap = self.heights_m[i] - self.interpolate(displacement, i);
-            self.gaps_m[i] = gap;
-            if gap > -margin_m {
-                self.candidates[self.candidate_count] = i;
-                self.candidate_count += 1;
-                self.forces[i] = 0.0;
-                self.steps_m[i] = 0.0;
-                self.jacobian[i] = 0.0;
-                self.squared_gap_changes[i] = 0.0;
-            }
+        let count = self.count;
+        let [w0, w1, w2, w3] = &self.weight_columns;
+        self.kernels.barrier_gaps(
+            &self.heights_m[..count],
+            [&w0[..count], &w1[..count], &w2[..count], &w3[..count]],
+            &self.segments[..self.segment_count],
+            displacement,
+            &mut self.gaps_m[..count],
+        );
+        let mut candidate_count = 0;
+        for (i, gap) in self.gaps_m[..count].iter().enumerate() {
+            // Branch-free compaction: the slot is written always, kept only for candidates.
+            self.candidates[candidate_count] = i;
+            candidate_count += (*gap > -margin_m) as usize;
         }
+        self.candidate_count = candidate_count;
+        // Points are in order along the string, so their free stencils are too.
+        self.candidate_nodes = match self.candidates[..candidate_count] {
+            [] => (1, 0),
+            [first, .., last] => (self.free_first_node[first], self.free_first_node[last] + 3),
+            [only] => (self.free_first_node[only], self.free_first_node[only] + 3),
+        };
+    }
+
+    /// The free string nodes `first..=last` that the current candidates' stencils reach, or
+    /// None without candidates: the only nodes on which this barrier can act during the step.
+    pub fn candidate_node_range(&self) -> Option<(usize, usize)> {
+        let (first, last) = self.candidate_nodes;
+        (first <= last).then_some((first, last))
     }
 
     fn candidate_indices(&self) -> &[usize] {
@@ -234,7 +335,7 @@ impl BarrierGrid {
     pub fn touches_during(&self, step: &[f64]) -> bool {
         self.candidate_indices().iter().any(|&i| {
             let gap = self.gaps_m[i];
-            gap > 0.0 || gap - self.interpolate(step, i) > 0.0
+            gap > 0.0 || gap - self.interpolate_step(step, i) > 0.0
         })
     }
 
@@ -242,12 +343,78 @@ impl BarrierGrid {
     pub fn evaluate(&mut self, step: &[f64]) {
         for index in 0..self.candidate_count {
             let i = self.candidates[index];
-            let point_step = self.interpolate(step, i);
+            let point_step = self.interpolate_step(step, i);
             let contact = self.law.midpoint_force(self.gaps_m[i], point_step);
             self.steps_m[i] = point_step;
             self.forces[i] = contact.force;
             self.jacobian[i] = contact.stiffness;
             self.squared_gap_changes[i] = contact.squared_gap_change;
+        }
+    }
+
+    /// Evaluates the contact law of every candidate at the step `step` and adds, in the same
+    /// pass, `I* f̃` into the full-node vector `node_forces` and `I* C I` into the banded block
+    /// `band` (`band[r][k]` is the entry of string nodes `first_node + r` and
+    /// `first_node + r − k`, the lower triangle), which must hold
+    /// [`BarrierGrid::candidate_node_range`]. The per-point results are not kept (the
+    /// accepted step's come from [`BarrierGrid::evaluate_forces_into`]): the fused loop of the
+    /// condensed Newton update (`condensed.rs`).
+    pub fn evaluate_into_band(
+        &self,
+        step: &[f64],
+        node_forces: &mut [f64],
+        band: &mut [[f64; 4]],
+        first_node: usize,
+    ) {
+        let scale = self.transpose_scale;
+        for &i in &self.candidates[..self.candidate_count] {
+            let first = self.free_first_node[i];
+            let w = &self.free_weights[i];
+            let contact = self
+                .law
+                .midpoint_force(self.gaps_m[i], step_at(w, step, first));
+            if contact.stiffness == 0.0 && contact.force == 0.0 {
+                continue;
+            }
+            let force = scale * contact.force;
+            let nodes: &mut [f64; 4] = (&mut node_forces[first..first + 4])
+                .try_into()
+                .expect("four nodes");
+            for (node, weight) in nodes.iter_mut().zip(w) {
+                *node += weight * force;
+            }
+            // Rows first..first + 4 of I* C I: row j holds c w_j w_k at offset j − k ≤ j.
+            let rows: &mut [[f64; 4]; 4] = (&mut band[first - first_node..][..4])
+                .try_into()
+                .expect("four rows");
+            let c = scale * contact.stiffness;
+            for j in 0..4 {
+                let scaled = c * w[j];
+                for k in 0..=j {
+                    rows[j][j - k] += scaled * w[k];
+                }
+            }
+        }
+    }
+
+    /// Evaluates the candidates at the step `step` (as [`BarrierGrid::evaluate`]) and adds
+    /// `I* f̃` into the full-node vector `node_forces`, in one pass.
+    pub fn evaluate_forces_into(&mut self, step: &[f64], node_forces: &mut [f64]) {
+        for &i in &self.candidates[..self.candidate_count] {
+            let first = self.free_first_node[i];
+            let w = &self.free_weights[i];
+            let point_step = dot4(w, &step[first..]);
+            let contact = self.law.midpoint_force(self.gaps_m[i], point_step);
+            self.steps_m[i] = point_step;
+            self.forces[i] = contact.force;
+            self.jacobian[i] = contact.stiffness;
+            self.squared_gap_changes[i] = contact.squared_gap_change;
+            if contact.force != 0.0 {
+                let force = self.transpose_scale * contact.force;
+                for (node, weight) in node_forces[first..first + 4].iter_mut().zip(w) {
+                    *node += weight * force;
+                }
+            }
         }
     }
 
@@ -303,14 +470,6 @@ impl BarrierGrid {
             if column_node <= row_node {
                 jacobian.add(row_node - 1, column_node - 1, value);
             }
-        });
-    }
-
-    /// Adds the block of `I* C I` on nodes `first_node..first_node + size` into the dense
-    /// row-major `size × size` matrix `dense` (every stencil must lie inside that block).
-    pub fn add_jacobian_dense(&self, dense: &mut [f64], size: usize, first_node: usize) {
-        self.for_each_jacobian_entry(|row_node, column_node, value| {
-            dense[(row_node - first_node) * size + column_node - first_node] += value;
         });
     }
 

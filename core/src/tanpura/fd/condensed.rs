@@ -12,34 +12,58 @@
 //!
 //! with the Jacobian `S + (Σ I* C I)_CC`, symmetric positive definite like the full one. Newton
 //! on this reduced system produces the same iterates as Newton on the whole string (the
-//! eliminated unknowns are linear), at O(|C|³) per iteration instead of O(N·w²); one banded solve
-//! `A s = −c + f` recovers the whole step afterwards. Energy stability is untouched: the accepted
-//! `s` solves the same discrete equations (to the Newton tolerance), so the discrete energy
-//! balance of the full scheme holds as before. `S` depends only on `A`, so it is recomputed
-//! only when the string's parameters change.
+//! eliminated unknowns are linear).
+//!
+//! Within a step the forces act only on the nodes `C' ⊂ C` that the *candidate* points'
+//! stencils reach (the points that can touch during the step, `barrier_grid.rs`), typically half
+//! of `C`. The same elimination applied to `C'` gives `S' = [(A⁻¹)_C'C']⁻¹` and Newton on `C'`
+//! alone, again with the same iterates: the unknowns of `C \ C'` carry no force and are linear.
+//! `S'` is the inverse of a principal block of the precomputed `G = (A⁻¹)_CC`; it is cached and
+//! recomputed (O(|C'|³), allocation-free) only when the block changes, which the candidate set
+//! does every few hundred steps. Each update factorises the small SPD Jacobian by LDLᵀ.
+//!
+//! After Newton, the influence matrix `A⁻¹ e_j` (one precomputed column of the whole string's
+//! response per contact node) recovers the whole step, `s = s_lin + Σ_j f_j A⁻¹ e_j`, over the
+//! nodes that carry a force: one banded solve per time step (the predictor) and no second one.
+//! Energy stability is untouched: the accepted `s` solves the same discrete equations (to the
+//! Newton tolerance), so the discrete energy balance of the full scheme holds as before. `G` and
+//! the influence columns depend only on `A`, so they are recomputed only when the string's
+//! parameters change.
 
 use crate::banded::{BandedLdlt, NotPositiveDefinite};
-use crate::dense::DenseCholesky;
+use crate::tanpura::fd::kernels::Kernels;
 
-/// The contact block `C = first_node..first_node + size` and its Schur complement.
+/// The contact block `C = first_node..first_node + size`, its Schur complements and the
+/// influence columns.
 #[derive(Debug, Clone)]
 pub struct ContactCondensation {
     first_node: usize,
     size: usize,
-    /// S = [(A⁻¹)_CC]⁻¹, row-major.
-    schur: Vec<f64>,
-    /// S + (Σ I* C I)_CC for the current iterate.
+    /// N + 1, the length of a full-node vector.
+    full_nodes: usize,
+    /// G = (A⁻¹)_CC, row-major `size × size`.
+    inverse_block: Vec<f64>,
+    /// Column j (j = 0..size) is `A⁻¹ e_{first_node + j}` as a full-node vector (zero at the
+    /// fixed ends): the whole string's response to a unit scaled force on contact node j.
+    response: Vec<f64>,
+    /// The active block C' = `active_first..active_first + active_size` (nodes) and its
+    /// Schur complement S' = [G_C'C']⁻¹, row-major; `active_size == 0` when none is cached.
+    active_first: usize,
+    active_size: usize,
+    active_schur: Vec<f64>,
+    /// (Σ I* C I)_C'C' for the current iterate, banded: `band[r][k]` couples the block's nodes
+    /// r and r − k (the contact stencils span four nodes).
+    band: Vec<[f64; 4]>,
+    /// S' + the band (lower triangle), then its LDLᵀ factors.
     jacobian: Vec<f64>,
-    factor: DenseCholesky,
     /// s_lin on C.
     predictor: Vec<f64>,
-    /// G = A⁻¹ restricted to the columns of C, row-major (N − 1) × |C|: the response of the
-    /// whole string to a unit force on each contact node.
-    response: Vec<f64>,
     /// The last accepted contact correction s_C − s_lin,C, the next step's initial guess.
     previous_correction: Vec<f64>,
-    /// The reduced residual, then the Newton update.
+    /// The reduced residual, then the Newton update (length |C'|).
     update: Vec<f64>,
+    /// Scratch row of the LDLᵀ factorisation.
+    scratch: Vec<f64>,
 }
 
 impl ContactCondensation {
@@ -47,16 +71,22 @@ impl ContactCondensation {
     /// `unknowns` = N − 1 free nodes. Allocates.
     pub fn new(first_node: usize, last_node: usize, unknowns: usize) -> Self {
         let size = last_node + 1 - first_node;
+        let full_nodes = unknowns + 2;
         Self {
             first_node,
             size,
-            schur: vec![0.0; size * size],
+            full_nodes,
+            inverse_block: vec![0.0; size * size],
+            response: vec![0.0; size * full_nodes],
+            active_first: first_node,
+            active_size: 0,
+            active_schur: vec![0.0; size * size],
+            band: vec![[0.0; 4]; size],
             jacobian: vec![0.0; size * size],
-            factor: DenseCholesky::with_capacity(size),
             predictor: vec![0.0; size],
-            response: vec![0.0; unknowns * size],
             previous_correction: vec![0.0; size],
             update: vec![0.0; size],
+            scratch: vec![0.0; size],
         }
     }
 
@@ -68,8 +98,13 @@ impl ContactCondensation {
         self.size
     }
 
-    /// Recomputes `S` from the factorised step matrix `A` (N − 1 unknowns; row i ↔ node i + 1).
-    /// `column` is scratch of length ≥ N − 1. Allocation-free.
+    /// The active block C' as (first node, size).
+    pub fn active_block(&self) -> (usize, usize) {
+        (self.active_first, self.active_size)
+    }
+
+    /// Recomputes `G` and the influence columns from the factorised step matrix `A` (N − 1
+    /// unknowns; row i ↔ node i + 1). `column` is scratch of length ≥ N − 1. Allocation-free.
     pub fn prepare(
         &mut self,
         step_factor: &BandedLdlt,
@@ -77,31 +112,71 @@ impl ContactCondensation {
     ) -> Result<(), NotPositiveDefinite> {
         let size = self.size;
         let offset = self.first_node - 1;
-        // G = (A⁻¹)_CC, column by column, stored in `jacobian` for the moment.
-        let unknowns = self.response.len() / size;
+        let unknowns = self.full_nodes - 2;
+        let column = &mut column[..unknowns];
         for j in 0..size {
             column.fill(0.0);
             column[offset + j] = 1.0;
             step_factor.solve_in_place(column);
             for i in 0..size {
-                self.jacobian[i * size + j] = column[offset + i];
+                self.inverse_block[i * size + j] = column[offset + i];
             }
-            for (row, value) in column[..unknowns].iter().enumerate() {
-                self.response[row * size + j] = *value;
-            }
+            let response = &mut self.response[j * self.full_nodes..(j + 1) * self.full_nodes];
+            response.fill(0.0);
+            response[1..=unknowns].copy_from_slice(column);
         }
         self.previous_correction.fill(0.0);
-        // S = G⁻¹, column by column.
-        self.factor.factorise(&self.jacobian, size)?;
-        for j in 0..size {
-            self.update.fill(0.0);
-            self.update[j] = 1.0;
-            self.factor.solve_in_place(&mut self.update);
-            for i in 0..size {
-                self.schur[i * size + j] = self.update[i];
-            }
+        self.active_size = 0;
+        // G must be positive definite: check it once here, so that every principal block the
+        // steps ask for is (up to round-off) as well.
+        self.active_schur[..size * size].copy_from_slice(&self.inverse_block);
+        if !ldlt_in_place(&mut self.active_schur, size, &mut self.scratch) {
+            return Err(NotPositiveDefinite { row: 0 });
         }
         Ok(())
+    }
+
+    /// Makes the nodes `first..=last` (inside C) the active block, recomputing its Schur
+    /// complement `S' = [G_C'C']⁻¹` unless it is the cached one. Returns false, leaving no
+    /// block cached, if that principal block of `G` is not positive definite (round-off on an
+    /// ill-conditioned `A`). Allocation-free.
+    pub fn set_active_block(&mut self, first: usize, last: usize) -> bool {
+        debug_assert!(first >= self.first_node && last < self.first_node + self.size);
+        let size = last + 1 - first;
+        if first == self.active_first && size == self.active_size {
+            return true;
+        }
+        self.active_first = first;
+        self.active_size = size;
+        let offset = first - self.first_node;
+        // Factorise G_C'C' (in `jacobian`), then S' column by column.
+        for i in 0..size {
+            let source = &self.inverse_block[(offset + i) * self.size + offset..][..size];
+            self.jacobian[i * size..(i + 1) * size].copy_from_slice(source);
+        }
+        if !ldlt_in_place(&mut self.jacobian, size, &mut self.scratch) {
+            self.active_size = 0;
+            return false;
+        }
+        for j in 0..size {
+            let unit = &mut self.update[..size];
+            unit.fill(0.0);
+            unit[j] = 1.0;
+            ldlt_solve(&self.jacobian, size, unit);
+            for i in 0..size {
+                self.active_schur[i * size + j] = unit[i];
+            }
+        }
+        // Symmetrise: S' is symmetric, its computed columns only to round-off.
+        for i in 0..size {
+            for j in 0..i {
+                let mean =
+                    0.5 * (self.active_schur[i * size + j] + self.active_schur[j * size + i]);
+                self.active_schur[i * size + j] = mean;
+                self.active_schur[j * size + i] = mean;
+            }
+        }
+        true
     }
 
     /// Records `s_lin` on C from the full-node predictor step.
@@ -110,11 +185,17 @@ impl ContactCondensation {
             .copy_from_slice(&step[self.first_node..self.first_node + self.size]);
     }
 
-    /// Starts Newton from `s_lin,C` plus the previous step's contact correction: contact forces
-    /// vary smoothly from step to step, so this guess saves about one iteration.
+    /// Starts Newton on the active block from `s_lin` plus the previous step's contact
+    /// correction: contact forces vary smoothly from step to step, so this guess saves about one
+    /// iteration.
     pub fn apply_initial_guess(&self, step: &mut [f64]) {
-        for (i, correction) in self.previous_correction.iter().enumerate() {
-            step[self.first_node + i] = self.predictor[i] + correction;
+        let offset = self.active_first - self.first_node;
+        let range = offset..offset + self.active_size;
+        let guesses = self.predictor[range.clone()]
+            .iter()
+            .zip(&self.previous_correction[range]);
+        for (s, (predictor, correction)) in step[self.active_first..].iter_mut().zip(guesses) {
+            *s = predictor + correction;
         }
     }
 
@@ -123,19 +204,45 @@ impl ContactCondensation {
         self.previous_correction.fill(0.0);
     }
 
-    /// Recovers the whole step from the predictor and the contact forces on C:
-    /// `s = s_lin + G f_C` (full-node vectors; `step` holds `s_lin` outside C on entry).
-    pub fn recover_step(&mut self, step: &mut [f64], contact: &[f64]) {
-        let size = self.size;
-        let first = self.first_node;
-        step[first..first + size].copy_from_slice(&self.predictor);
-        let forces = &contact[first..first + size];
-        for (row, response) in self.response.chunks_exact(size).enumerate() {
-            let correction: f64 = response.iter().zip(forces).map(|(g, f)| g * f).sum();
-            step[row + 1] += correction;
+    /// The largest |s| on C of the step `s = s_lin + G f` that the forces `contact` (full-node,
+    /// nonzero on the active block only) give, without forming it elsewhere: the reach check
+    /// of the candidate margin.
+    pub fn block_step_max_abs(&self, contact: &[f64]) -> f64 {
+        let offset = self.active_first - self.first_node;
+        let forces = &contact[self.active_first..self.active_first + self.active_size];
+        let mut largest = 0.0f64;
+        for (i, predictor) in self.predictor.iter().enumerate() {
+            let row = &self.inverse_block[i * self.size + offset..][..self.active_size];
+            let correction: f64 = row.iter().zip(forces).map(|(g, f)| g * f).sum();
+            largest = largest.max((predictor + correction).abs());
         }
-        for i in 0..size {
-            self.previous_correction[i] = step[first + i] - self.predictor[i];
+        largest
+    }
+
+    /// Recovers the whole step from the predictor and the contact forces on the active block:
+    /// `s = s_lin + Σ_j f_j A⁻¹ e_j` (full-node vectors; `step` holds `s_lin` outside the
+    /// active block on entry). Records the contact correction on C for the next step.
+    pub fn recover_step(&mut self, kernels: &Kernels, step: &mut [f64], contact: &[f64]) {
+        let first = self.first_node;
+        let size = self.size;
+        step[first..first + size].copy_from_slice(&self.predictor);
+        let offset = self.active_first - first;
+        let forces = &contact[self.active_first..self.active_first + self.active_size];
+        for (j, &force) in forces.iter().enumerate() {
+            if force != 0.0 {
+                let column = offset + j;
+                let response =
+                    &self.response[column * self.full_nodes..(column + 1) * self.full_nodes];
+                kernels.axpy(force, response, step);
+            }
+        }
+        for ((correction, s), predictor) in self
+            .previous_correction
+            .iter_mut()
+            .zip(&step[first..first + size])
+            .zip(&self.predictor)
+        {
+            *correction = s - predictor;
         }
     }
 
@@ -144,33 +251,115 @@ impl ContactCondensation {
         self.predictor.iter().fold(0.0, |a, s| a.max(s.abs()))
     }
 
-    /// The jacobian buffer, reset to S, for barriers to add their `I* C I` block into.
-    pub fn jacobian_reset_to_schur(&mut self) -> &mut [f64] {
-        self.jacobian.copy_from_slice(&self.schur);
-        &mut self.jacobian
+    /// The contact Jacobian band of the active block, zeroed, for barriers to add their
+    /// `I* C I` into; with the block's first node and size.
+    pub fn contact_band_reset(&mut self) -> (&mut [[f64; 4]], usize, usize) {
+        let band = &mut self.band[..self.active_size];
+        band.fill([0.0; 4]);
+        (band, self.active_first, self.active_size)
     }
 
-    /// One Newton update on C: with the contact forces `contact` (full-node, I* f̃) already
-    /// evaluated at `step` and the Jacobian assembled, solves and applies the update to `step`
-    /// on C. Returns ‖δ‖∞, or None when the Jacobian is not positive definite.
+    /// One Newton update on the active block: with the contact forces `contact` (full-node,
+    /// I* f̃) and the contact band already evaluated at `step`, forms the Jacobian
+    /// `S' + I* C I`, solves and applies the update to `step` on the block. Returns ‖δ‖∞, or
+    /// None when the Jacobian is not positive definite.
     pub fn update(&mut self, step: &mut [f64], contact: &[f64]) -> Option<f64> {
-        let size = self.size;
-        let first = self.first_node;
-        for i in 0..size {
-            let mut value = -contact[first + i];
-            for j in 0..size {
-                value += self.schur[i * size + j] * (step[first + j] - self.predictor[j]);
+        let size = self.active_size;
+        let first = self.active_first;
+        let offset = first - self.first_node;
+        let cells = size * size;
+        self.jacobian[..cells].copy_from_slice(&self.active_schur[..cells]);
+        for (row, entries) in self.band[..size].iter().enumerate() {
+            for (k, value) in entries.iter().enumerate().take(row + 1) {
+                self.jacobian[row * size + row - k] += value;
             }
-            self.update[i] = value;
         }
-        self.factor.factorise(&self.jacobian, size).ok()?;
-        self.factor.solve_in_place(&mut self.update);
+        // R = S' (s − s_lin) − f on the block; `scratch` holds s − s_lin.
+        let block_step = &step[first..first + size];
+        for ((difference, s), predictor) in self.scratch[..size]
+            .iter_mut()
+            .zip(block_step)
+            .zip(&self.predictor[offset..offset + size])
+        {
+            *difference = s - predictor;
+        }
+        let forces = &contact[first..first + size];
+        let rows = self.active_schur[..size * size].chunks_exact(size);
+        for ((residual, row), force) in self.update[..size].iter_mut().zip(rows).zip(forces) {
+            let product: f64 = row
+                .iter()
+                .zip(&self.scratch[..size])
+                .map(|(a, b)| a * b)
+                .sum();
+            *residual = product - force;
+        }
+        if !ldlt_in_place(&mut self.jacobian[..size * size], size, &mut self.scratch) {
+            return None;
+        }
+        ldlt_solve(
+            &self.jacobian[..size * size],
+            size,
+            &mut self.update[..size],
+        );
         let mut largest = 0.0f64;
-        for i in 0..size {
-            step[first + i] -= self.update[i];
-            largest = largest.max(self.update[i].abs());
+        for (s, delta) in step[first..first + size]
+            .iter_mut()
+            .zip(&self.update[..size])
+        {
+            *s -= delta;
+            largest = largest.max(delta.abs());
         }
         Some(largest)
+    }
+}
+
+/// Factorises the symmetric positive definite row-major `size × size` matrix (only its lower
+/// triangle is read) in place as `L D Lᵀ`: the strict lower triangle receives L, the diagonal
+/// receives 1/D. Returns false if a pivot is not positive. `row_scratch` holds ≥ size values.
+/// O(size³/6) multiply-adds, square-root free, allocation-free.
+fn ldlt_in_place(matrix: &mut [f64], size: usize, row_scratch: &mut [f64]) -> bool {
+    for i in 0..size {
+        let (done, rest) = matrix.split_at_mut(i * size);
+        let row = &mut rest[..size];
+        // u_j = L_ij D_j = A_ij − Σ_{k<j} u_k L_jk, for j < i (u kept in `row_scratch`).
+        let u = &mut row_scratch[..i];
+        for j in 0..i {
+            let previous = &done[j * size..j * size + j];
+            let dot: f64 = u[..j].iter().zip(previous).map(|(a, b)| a * b).sum();
+            u[j] = row[j] - dot;
+        }
+        // L_ij = u_j / D_j and D_i = A_ii − Σ_j u_j L_ij.
+        let mut diagonal = row[i];
+        for j in 0..i {
+            let l = u[j] * done[j * size + j];
+            row[j] = l;
+            diagonal -= u[j] * l;
+        }
+        if diagonal.is_nan() || diagonal <= 0.0 {
+            return false;
+        }
+        row[i] = 1.0 / diagonal;
+    }
+    true
+}
+
+/// Solves `L D Lᵀ x = rhs` in place with the factors of [`ldlt_in_place`].
+fn ldlt_solve(factors: &[f64], size: usize, solution: &mut [f64]) {
+    let solution = &mut solution[..size];
+    for i in 0..size {
+        let row = &factors[i * size..i * size + i];
+        let dot: f64 = row.iter().zip(&solution[..i]).map(|(l, x)| l * x).sum();
+        solution[i] -= dot;
+    }
+    for (i, x) in solution.iter_mut().enumerate() {
+        *x *= factors[i * size + i];
+    }
+    for i in (0..size).rev() {
+        let x = solution[i];
+        let row = &factors[i * size..i * size + i];
+        for (target, l) in solution[..i].iter_mut().zip(row) {
+            *target -= l * x;
+        }
     }
 }
 
@@ -199,6 +388,7 @@ mod tests {
         let mut scratch = vec![0.0; unknowns];
         condensation.prepare(&factor, &mut scratch).unwrap();
         // For a force f on C: s = s_lin + A⁻¹ f, and S (s_C − s_lin,C) must equal f_C.
+        assert!(condensation.set_active_block(4, 7));
         let rhs: Vec<f64> = (0..unknowns).map(|i| (i as f64).sin()).collect();
         let mut s_lin = rhs.clone();
         factor.solve_in_place(&mut s_lin);
@@ -211,7 +401,7 @@ mod tests {
         for i in 0..4 {
             let mut value = 0.0;
             for j in 0..4 {
-                value += condensation.schur[i * 4 + j] * (with_force[3 + j] - s_lin[3 + j]);
+                value += condensation.active_schur[i * 4 + j] * (with_force[3 + j] - s_lin[3 + j]);
             }
             assert!((value - force[i]).abs() < 1e-12, "{value} vs {}", force[i]);
         }
@@ -223,9 +413,60 @@ mod tests {
         for (k, f) in force.iter().enumerate() {
             contact[4 + k] = *f;
         }
-        condensation.recover_step(&mut step, &contact);
+        condensation.recover_step(&Kernels::detect(), &mut step, &contact);
         for i in 0..unknowns {
             assert!((step[i + 1] - with_force[i]).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn sub_block_schur_complement_matches_forces_on_the_sub_block() {
+        // The same matrix, C = nodes 3..=9, forces only on C' = nodes 5..=7.
+        let unknowns = 12;
+        let mut a = SymmetricBanded::zeros(unknowns, 2);
+        for row in 0..unknowns {
+            a.set(row, row, 6.0 + 0.1 * row as f64);
+            if row >= 1 {
+                a.set(row, row - 1, -2.0);
+            }
+            if row >= 2 {
+                a.set(row, row - 2, 0.5);
+            }
+        }
+        let mut factor = BandedLdlt::with_shape(unknowns, 2);
+        factor.factorise(&a).unwrap();
+        let mut condensation = ContactCondensation::new(3, 9, unknowns);
+        let mut scratch = vec![0.0; unknowns];
+        condensation.prepare(&factor, &mut scratch).unwrap();
+        assert!(condensation.set_active_block(5, 7));
+        assert_eq!(condensation.active_block(), (5, 3));
+        let force = [0.4, -0.2, 1.5];
+        let mut response = vec![0.0; unknowns];
+        for (k, f) in force.iter().enumerate() {
+            response[4 + k] = *f;
+        }
+        factor.solve_in_place(&mut response);
+        for i in 0..3 {
+            let value: f64 = (0..3)
+                .map(|j| condensation.active_schur[i * 3 + j] * response[4 + j])
+                .sum();
+            assert!((value - force[i]).abs() < 1e-12, "{value} vs {}", force[i]);
+        }
+    }
+
+    #[test]
+    fn ldlt_solves_a_known_system() {
+        // [[4,2,0],[2,5,1],[0,1,3]] x = [2, 7, 7] has x = [0, 1, 2]; only the lower triangle
+        // is read, so the upper one holds garbage.
+        let mut matrix = [4.0, 99.0, 99.0, 2.0, 5.0, 99.0, 0.0, 1.0, 3.0];
+        let mut scratch = [0.0; 3];
+        assert!(ldlt_in_place(&mut matrix, 3, &mut scratch));
+        let mut x = [2.0, 7.0, 7.0];
+        ldlt_solve(&matrix, 3, &mut x);
+        for (value, expected) in x.iter().zip([0.0, 1.0, 2.0]) {
+            assert!((value - expected).abs() < 1e-14);
+        }
+        let mut indefinite = [1.0, 0.0, 2.0, 1.0];
+        assert!(!ldlt_in_place(&mut indefinite, 2, &mut scratch));
     }
 }

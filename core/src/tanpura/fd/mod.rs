@@ -10,14 +10,23 @@
 //! - `barrier_grid.rs`: bridge, thread and finger on their own fine grids, tied to the string by
 //!   cubic Lagrange interpolation and its scaled transpose (eq. 17–25);
 //! - `condensed.rs`: Newton reduced to the contact nodes through a Schur complement;
-//! - `decimator.rs`: the Kaiser FIR from the internal rate to the output rate.
+//! - `decimator.rs`: the Kaiser FIR from the internal rate to the output rate;
+//! - `kernels.rs`: the passes over the whole string (predictor right-hand side, contact
+//!   correction, state update) as runtime-dispatched SIMD kernels.
 //!
 //! Each step finds `s = yⁿ⁺¹ − yⁿ` as the root of eq. 22 and updates `yⁿ⁺¹ = yⁿ + s`,
 //! `qⁿ⁺¹ = s − qⁿ` (eq. 16). The step first solves the linear part alone with the prefactorised
-//! `A` (the string without contact). If no barrier point has a positive gap before or after that
-//! step, no contact force acts and the linear step *is* the exact root: Newton is skipped.
-//! Otherwise a bounded Newton iteration (`newton.rs`) starts from it. The barrier profiles are
-//! those of `geometry.rs`; the finger's grid is 1 mm.
+//! `A` (the string without contact): the one banded solve of the step. If no barrier point has a
+//! positive gap before or after that step, no contact force acts and the linear step *is* the
+//! exact root: Newton is skipped. Otherwise a bounded Newton iteration (`newton.rs`) starts from
+//! it, on the contact nodes only (`condensed.rs`), and the precomputed influence columns of
+//! those nodes add the contact correction to the whole string. The barrier profiles are those of
+//! `geometry.rs`; the finger's grid is 1 mm.
+//!
+//! Work that only tools need is not done per step: the loss ledger is booked only with
+//! `track_energy` on (the energy-balance tests and `xtask simulate` turn it on), and the
+//! deepest penetration is computed when asked for from what the last step left in the barrier
+//! grids.
 //!
 //! Energy (eq. 8–9): `H = Σ Δx [p²/2ρA] + V_string + Δx_b Σ k_b/2⌊a⌋² + Δx_c Σ k_c/2⌊a⌋²`.
 //! The scheme gives `Hⁿ⁺¹ − Hⁿ = −(losses over the step)` exactly; a pluck changes H by the
@@ -31,11 +40,13 @@ use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
 use crate::tanpura::string::StringParameters;
 use barrier_grid::{lagrange_stencil, BarrierGrid};
 use condensed::ContactCondensation;
+use kernels::Kernels;
 use operator::StringOperator;
 
 pub mod barrier_grid;
 pub mod condensed;
 pub mod decimator;
+pub mod kernels;
 pub mod operator;
 
 /// How the Newton iteration of each step is solved.
@@ -63,7 +74,9 @@ pub struct FdStringConfig {
     pub finger: FingerSettings,
     pub newton: NewtonSettings,
     pub solver: SolverKind,
-    /// Book the losses of every step (costs a few O(N) passes; tests and research tools).
+    /// Book the losses of every step into [`FdString::cumulative_losses_j`] (costs a few O(N)
+    /// passes per step; the energy-balance tests and research tools turn it on, the audio path
+    /// leaves it off). Also switchable on a built string with [`FdString::set_track_energy`].
     pub track_energy: bool,
 }
 
@@ -126,8 +139,9 @@ struct StepSolver {
     jacobian_factor: BandedLdlt,
     /// s, full-node vector (zero at the fixed ends).
     step: Vec<f64>,
-    /// 2(D yⁿ − d_b − qⁿ), the constant part of the residual.
-    constant: Vec<f64>,
+    /// The predictor's right-hand side −2(D yⁿ − d_b − qⁿ): minus the constant part of the
+    /// residual.
+    predictor_rhs: Vec<f64>,
     /// Σ I* f̃ on the string nodes.
     contact: Vec<f64>,
     residual: Vec<f64>,
@@ -140,21 +154,84 @@ struct StepSolver {
 }
 
 impl StepSolver {
-    /// One Newton update on the contact region only (see `condensed.rs`).
+    /// One Newton update on the active contact block only (see `condensed.rs`).
     fn condensed_update(&mut self) -> Option<f64> {
         let condensation = self.condensation.as_mut()?;
-        let first = condensation.first_node();
-        let size = condensation.size();
+        let (band, first, size) = condensation.contact_band_reset();
         self.contact[first..first + size].fill(0.0);
-        let jacobian = condensation.jacobian_reset_to_schur();
-        for barrier in [&mut self.bridge, &mut self.thread] {
+        for barrier in [&self.bridge, &self.thread] {
             if barrier.is_active() {
-                barrier.evaluate(&self.step);
-                barrier.spread_forces(&mut self.contact);
-                barrier.add_jacobian_dense(jacobian, size, first);
+                barrier.evaluate_into_band(&self.step, &mut self.contact, band, first);
             }
         }
         condensation.update(&mut self.step, &self.contact)
+    }
+
+    /// The free nodes that the active barriers' candidates can act on this step.
+    fn candidate_node_range(&self) -> Option<(usize, usize)> {
+        [&self.bridge, &self.thread]
+            .into_iter()
+            .filter(|barrier| barrier.is_active())
+            .filter_map(|barrier| barrier.candidate_node_range())
+            .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+    }
+
+    /// The condensed Newton solve of a step with contact (`condensed.rs`), from the predictor
+    /// in `step`, ending with the whole step in `step` and the forces of the accepted step in
+    /// the barrier grids. Points farther from contact than `margin` were left out of the
+    /// candidates; if the accepted step reaches that far (`lebesgue` bounds the interpolated
+    /// step), the solve is redone with every point. Returns (updates, converged).
+    fn solve_condensed(
+        &mut self,
+        kernels: &Kernels,
+        displacement: &[f64],
+        settings: &NewtonSettings,
+        mut margin: f64,
+        lebesgue: f64,
+    ) -> (u32, bool) {
+        let mut outcome = (0, true);
+        loop {
+            let Some((first, last)) = self.candidate_node_range() else {
+                return outcome;
+            };
+            let Some(condensation) = self.condensation.as_mut() else {
+                return (0, false);
+            };
+            if !condensation.set_active_block(first, last) {
+                // A principal block of A⁻¹ that round-off made indefinite: fail soft with the
+                // contact-free step (its forces only reported), counted as a cap hit.
+                for barrier in [&mut self.bridge, &mut self.thread] {
+                    if barrier.is_active() {
+                        barrier.evaluate(&self.step);
+                    }
+                }
+                return (outcome.0, false);
+            }
+            condensation.apply_initial_guess(&mut self.step);
+            let attempt = solve_bounded(self, settings);
+            outcome = (outcome.0 + attempt.0, attempt.1);
+            // Forces at the accepted step, for the recovery, the outputs and the ledger.
+            let condensation = self.condensation.as_mut().expect("checked above");
+            let (first, size) = condensation.active_block();
+            self.contact[first..first + size].fill(0.0);
+            for barrier in [&mut self.bridge, &mut self.thread] {
+                if barrier.is_active() {
+                    barrier.evaluate_forces_into(&self.step, &mut self.contact);
+                }
+            }
+            let reach = lebesgue * condensation.block_step_max_abs(&self.contact);
+            if reach < margin {
+                condensation.recover_step(kernels, &mut self.step, &self.contact);
+                return outcome;
+            }
+            // The step went farther than the candidate margin: redo with every point.
+            margin = f64::INFINITY;
+            for barrier in [&mut self.bridge, &mut self.thread] {
+                if barrier.is_active() {
+                    barrier.begin_step(displacement, margin);
+                }
+            }
+        }
     }
 }
 
@@ -173,11 +250,11 @@ impl NewtonSystem for StepSolver {
                 barrier.add_jacobian(&mut self.jacobian);
             }
         }
-        // F(s) = A s + constant − Σ I* f̃ (eq. 22).
+        // F(s) = A s + 2(D yⁿ − d_b − qⁿ) − Σ I* f̃ (eq. 22), the constant part being −rhs.
         self.step_matrix
             .multiply(&self.step[1..n], &mut self.residual[..n - 1]);
         for m in 1..n {
-            self.residual[m - 1] += self.constant[m] - self.contact[m];
+            self.residual[m - 1] -= self.predictor_rhs[m] + self.contact[m];
         }
         self.jacobian_factor.factorise(&self.jacobian).ok()?;
         self.jacobian_factor
@@ -205,12 +282,14 @@ pub struct FdString {
     /// The static equilibrium on bridge and thread (no finger, no motion).
     rest_displacement: Vec<f64>,
     scratch: Vec<f64>,
+    kernels: Kernels,
+    /// Whether the last step had contact (the barrier grids then hold its forces and steps).
+    touched_last_step: bool,
     stats: NewtonStats,
     nut_force_n: f64,
     bridge_force_n: f64,
     rest_nut_force_n: f64,
     rest_bridge_force_n: f64,
-    max_penetration_m: f64,
     cumulative_losses_j: f64,
     external_work_j: f64,
     static_solve_failures: u64,
@@ -239,7 +318,7 @@ impl FdString {
             jacobian: SymmetricBanded::zeros(n - 1, 3),
             jacobian_factor: BandedLdlt::with_shape(n - 1, 3),
             step: vec![0.0; n + 1],
-            constant: vec![0.0; n + 1],
+            predictor_rhs: vec![0.0; n + 1],
             contact: vec![0.0; n + 1],
             residual: vec![0.0; n + 1],
             bridge: BarrierGrid::with_capacity(bridge_capacity, n),
@@ -257,12 +336,13 @@ impl FdString {
             scaled_momentum: vec![0.0; n + 1],
             rest_displacement: vec![0.0; n + 1],
             scratch: vec![0.0; n + 1],
+            kernels: Kernels::detect(),
+            touched_last_step: false,
             stats: NewtonStats::default(),
             nut_force_n: 0.0,
             bridge_force_n: 0.0,
             rest_nut_force_n: 0.0,
             rest_bridge_force_n: 0.0,
-            max_penetration_m: 0.0,
             cumulative_losses_j: 0.0,
             external_work_j: 0.0,
             static_solve_failures: 0,
@@ -374,7 +454,7 @@ impl FdString {
         self.stats = NewtonStats::default();
         self.nut_force_n = self.rest_nut_force_n;
         self.bridge_force_n = self.rest_bridge_force_n;
-        self.max_penetration_m = 0.0;
+        self.touched_last_step = false;
         self.cumulative_losses_j = 0.0;
         self.external_work_j = 0.0;
         self.static_solve_failures = 0;
@@ -592,25 +672,27 @@ impl FdString {
     /// Advances one time step Δt. Allocation-free; never panics.
     pub fn step(&mut self) {
         let n = self.config.intervals;
-        let force_scale_twice = 2.0 * self.operator.force_scale();
+        let parameters = *self.operator.parameters();
+        let dx = self.operator.spacing_m();
+        let inverse_dx2 = 1.0 / (dx * dx);
+        let kernels = self.kernels;
         let solver = &mut self.solver;
-        // Constant part of the residual: 2(D yⁿ − d_b − qⁿ) = (Δt²/2ρA)(K yⁿ − b) − 2qⁿ.
-        self.operator
-            .restoring_force(&self.displacement, &mut solver.constant);
-        for m in 1..n {
-            solver.constant[m] =
-                force_scale_twice * solver.constant[m] - 2.0 * self.scaled_momentum[m];
-        }
-        // Contact-free predictor: A s = −constant.
-        for m in 1..n {
-            solver.step[m] = -solver.constant[m];
-        }
-        solver.step[0] = 0.0;
-        solver.step[n] = 0.0;
+        // Contact-free predictor: A s = −2(D yⁿ − d_b − qⁿ) = 2qⁿ − (Δt²/2ρA)(K yⁿ − b).
+        kernels.predictor_rhs(
+            &self.displacement,
+            &self.scaled_momentum,
+            inverse_dx2,
+            parameters.tension_n,
+            parameters.bending_stiffness_n_m2 * inverse_dx2,
+            2.0 * self.operator.force_scale(),
+            &mut self.scratch,
+            &mut solver.predictor_rhs,
+        );
+        solver.step.copy_from_slice(&solver.predictor_rhs);
         solver.step_factor.solve_in_place(&mut solver.step[1..n]);
 
         // Points farther from contact than any step can reach are left out of the Newton
-        // iteration; the bound is checked on the accepted step below.
+        // iteration; the bound is checked on the accepted step.
         let condensed = solver.kind == SolverKind::Condensed && solver.condensation.is_some();
         let lebesgue = solver
             .bridge
@@ -630,53 +712,31 @@ impl FdString {
                 touching |= barrier.touches_during(&solver.step);
             }
         }
-        if condensed && touching {
-            if let Some(condensation) = &solver.condensation {
-                condensation.apply_initial_guess(&mut solver.step);
-            }
-        }
-        let (iterations, converged) = if touching {
-            let mut outcome = solve_bounded(solver, &self.config.newton);
-            if condensed {
-                let reach = lebesgue * max_abs_on(&solver.step, solver.condensation.as_ref());
-                if reach >= margin {
-                    // The step went farther than the candidate margin: redo with every point.
-                    for barrier in [&mut solver.bridge, &mut solver.thread] {
-                        if barrier.is_active() {
-                            barrier.begin_step(&self.displacement, f64::INFINITY);
-                        }
-                    }
-                    let again = solve_bounded(solver, &self.config.newton);
-                    outcome = (outcome.0 + again.0, again.1);
-                }
-                // Recover the whole step: s = s_lin + A⁻¹ Σ I* f̃.
-                let condensation = solver.condensation.as_mut().expect("condensed");
-                let first = condensation.first_node();
-                let size = condensation.size();
-                solver.contact[first..first + size].fill(0.0);
-                for barrier in [&mut solver.bridge, &mut solver.thread] {
-                    if barrier.is_active() {
-                        barrier.evaluate(&solver.step);
-                        barrier.spread_forces(&mut solver.contact);
-                    }
-                }
-                condensation.recover_step(&mut solver.step, &solver.contact);
-            } else {
-                // Forces at the accepted step, for the outputs and the energy ledger.
-                for barrier in [&mut solver.bridge, &mut solver.thread] {
-                    if barrier.is_active() {
-                        barrier.evaluate(&solver.step);
-                    }
-                }
-            }
-            outcome
-        } else {
+        let (iterations, converged) = if !touching {
             if let Some(condensation) = &mut solver.condensation {
                 condensation.clear_correction();
             }
             (0, true)
+        } else if condensed {
+            solver.solve_condensed(
+                &kernels,
+                &self.displacement,
+                &self.config.newton,
+                margin,
+                lebesgue,
+            )
+        } else {
+            let outcome = solve_bounded(solver, &self.config.newton);
+            // Forces at the accepted step, for the outputs and the energy ledger.
+            for barrier in [&mut solver.bridge, &mut solver.thread] {
+                if barrier.is_active() {
+                    barrier.evaluate(&solver.step);
+                }
+            }
+            outcome
         };
         self.stats.record(iterations, converged);
+        self.touched_last_step = touching;
 
         if self.config.track_energy {
             let mut loss = self.operator.step_loss_j(&solver.step, &mut self.scratch);
@@ -690,28 +750,20 @@ impl FdString {
             self.cumulative_losses_j += loss;
         }
 
-        let mut finite = true;
-        for m in 1..n {
-            let s = solver.step[m];
-            self.displacement[m] += s;
-            self.scaled_momentum[m] = s - self.scaled_momentum[m];
-            finite &= s.is_finite();
-        }
+        let finite = kernels.advance_state(
+            &solver.step,
+            &mut self.displacement,
+            &mut self.scaled_momentum,
+        );
 
         let dt = self.config.time_step_s;
         let density = self.config.string.linear_density_kg_m;
         self.nut_force_n = self.operator.nut_force_n(&self.displacement);
-        if touching {
-            self.bridge_force_n =
-                solver.bridge.total_force_n(dt, density) + solver.thread.total_force_n(dt, density);
-            self.max_penetration_m = solver
-                .bridge
-                .max_penetration_after_step_m()
-                .max(solver.thread.max_penetration_after_step_m());
+        self.bridge_force_n = if touching {
+            solver.bridge.total_force_n(dt, density) + solver.thread.total_force_n(dt, density)
         } else {
-            self.bridge_force_n = 0.0;
-            self.max_penetration_m = 0.0;
-        }
+            0.0
+        };
         if !finite || !self.nut_force_n.is_finite() {
             // Fail soft: a non-finite state cannot recover, so silence the string at rest.
             self.non_finite_resets += 1;
@@ -719,7 +771,14 @@ impl FdString {
             self.scaled_momentum.fill(0.0);
             self.nut_force_n = self.rest_nut_force_n;
             self.bridge_force_n = self.rest_bridge_force_n;
+            self.touched_last_step = false;
         }
+    }
+
+    /// Turns the loss ledger on or off on a built string (see
+    /// [`FdStringConfig::track_energy`]); the ledger keeps what it booked so far.
+    pub fn set_track_energy(&mut self, track_energy: bool) {
+        self.config.track_energy = track_energy;
     }
 
     /// The discrete energy H (eq. 8–9) of the current state, J.
@@ -780,9 +839,17 @@ impl FdString {
         &self.stats
     }
 
-    /// Deepest penetration into bridge or thread after the last step, m.
+    /// Deepest penetration into bridge or thread after the last step, m (0 when it had no
+    /// contact). Computed on request from the last step's gaps and steps, not per step.
     pub fn max_penetration_m(&self) -> f64 {
-        self.max_penetration_m
+        if !self.touched_last_step {
+            return 0.0;
+        }
+        [&self.solver.bridge, &self.solver.thread]
+            .into_iter()
+            .filter(|barrier| barrier.is_active())
+            .map(|barrier| barrier.max_penetration_after_step_m())
+            .fold(0.0, f64::max)
     }
 
     /// Static solves (rest state or pluck) that hit their cap; 0 in normal operation.
@@ -896,19 +963,8 @@ impl FdString {
         self.external_work_j += self.energy_j() - energy_before;
         self.nut_force_n = self.rest_nut_force_n;
         self.bridge_force_n = self.rest_bridge_force_n;
-        self.max_penetration_m = 0.0;
+        self.touched_last_step = false;
     }
-}
-
-/// The largest |s| on the contact block (or on the whole string without one).
-fn max_abs_on(step: &[f64], condensation: Option<&ContactCondensation>) -> f64 {
-    let block = match condensation {
-        Some(condensation) => {
-            &step[condensation.first_node()..condensation.first_node() + condensation.size()]
-        }
-        None => step,
-    };
-    block.iter().fold(0.0, |a, s| a.max(s.abs()))
 }
 
 /// The string nodes that any bridge or thread stencil can reach, for every thread position in
