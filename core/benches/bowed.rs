@@ -7,9 +7,11 @@
 //!
 //! 1. The `cargo xtask bench` scene (`BowedNote`): A3 = 220 Hz on the violin A constants,
 //!    β = 0.1, v_b = 0.1 m/s, F_b = 0.4 N, 44.1 kHz, rendered from rest (attack included) in
-//!    64-sample blocks into an `f32` buffer, body filter on and off. Each figure is the median
-//!    (and best) of [`SCENE_RUNS`] runs of [`SCENE_S`] simulated seconds, each run from a reset
-//!    voice; the median is the honest figure on a shared machine, the best the least disturbed.
+//!    64-sample blocks into an `f32` buffer, body filter on and off; each block rendered by
+//!    `BowedVoice::process` (as xtask renders it) and, for comparison, by a `next_sample` call
+//!    per sample. Each figure is the median (and best) of [`SCENE_RUNS`] runs of [`SCENE_S`]
+//!    simulated seconds, each run from a reset voice; the median is the honest figure on a
+//!    shared machine, the best the least disturbed.
 //! 2. The same note played through [`BowedInstrument`] (MIDI note-on, every control smoothed and
 //!    set on the voice every sample, as the plugin plays it), both tiers, body on.
 //! 3. The steady-state table across sample rates (440 Hz, F_b = 0.3 N), best of [`RUNS`].
@@ -48,8 +50,10 @@ fn median_and_best(runs: usize, mut run: impl FnMut() -> f64) -> (f64, f64) {
     (times[times.len() / 2], times[0])
 }
 
-/// The xtask `BowedNote` scene from rest, in 64-sample blocks; elapsed seconds.
-fn scene_run<V: BowedVoice>(voice: &mut V, body: bool) -> f64 {
+/// The xtask `BowedNote` scene from rest, in 64-sample blocks rendered by
+/// [`BowedVoice::process`] (`per_sample` false, as xtask renders it) or by a
+/// [`BowedVoice::next_sample`] call per sample; elapsed seconds.
+fn scene_run<V: BowedVoice>(voice: &mut V, body: bool, per_sample: bool) -> f64 {
     voice.prepare(SCENE_RATE_HZ).unwrap();
     voice.set_pitch_hz(220.0);
     voice.set_bow_position(0.1);
@@ -63,8 +67,12 @@ fn scene_run<V: BowedVoice>(voice: &mut V, body: bool) -> f64 {
     let mut done = 0;
     while done < samples {
         let length = BLOCK.min(samples - done);
-        for sample in block[..length].iter_mut() {
-            *sample = voice.next_sample().radiated as f32;
+        if per_sample {
+            for sample in block[..length].iter_mut() {
+                *sample = voice.next_sample().radiated as f32;
+            }
+        } else {
+            voice.process(&mut block[..length]);
         }
         sum += black_box(&block)[0];
         done += length;
@@ -129,14 +137,15 @@ fn steady<V: BowedVoice>(voice: &mut V, sample_rate_hz: f64, body: bool) -> (f64
     (SIMULATED_S / best, 1e9 * best / samples as f64)
 }
 
-/// `cargo bench -p javari-core --bench bowed -- profile TIER BODY SECONDS` runs only the xtask
-/// scene for one voice (TIER `rounded` | `table` | `instrument-rounded` | `instrument-table`,
-/// BODY `on` | `off`), for `perf record` or `valgrind --tool=callgrind`, and prints its
-/// real-time factor.
+/// `cargo bench -p javari-core --bench bowed -- profile TIER BODY SECONDS [per-sample]` runs
+/// only the xtask scene for one voice (TIER `rounded` | `table` | `instrument-rounded` |
+/// `instrument-table`, BODY `on` | `off`), for `perf record` or `valgrind --tool=callgrind`,
+/// and prints its real-time factor.
 fn profile(args: &[String]) {
     let tier = args.first().map(String::as_str).unwrap_or("rounded");
     let body = args.get(1).map(String::as_str) != Some("off");
     let seconds: f64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(30.0);
+    let per_sample = args.get(3).map(String::as_str) == Some("per-sample");
     let runs = (seconds / SCENE_S).ceil().max(1.0) as usize;
     let capacity = BowedCapacity::default();
     let mut rounded = BowedString::new(capacity, StringConstants::violin_a());
@@ -144,10 +153,10 @@ fn profile(args: &[String]) {
     let mut total = 0.0;
     for _ in 0..runs {
         total += match tier {
-            "table" => scene_run(&mut table, body),
+            "table" => scene_run(&mut table, body, per_sample),
             "instrument-rounded" => instrument_run(BowTier::RoundedCorner),
             "instrument-table" => instrument_run(BowTier::BowTable),
-            _ => scene_run(&mut rounded, body),
+            _ => scene_run(&mut rounded, body, per_sample),
         };
     }
     println!(
@@ -158,7 +167,10 @@ fn profile(args: &[String]) {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| a != "--bench")
+        .collect();
     if args.first().map(String::as_str) == Some("profile") {
         profile(&args[1..]);
         return;
@@ -174,13 +186,19 @@ fn main() {
         "{:<28} {:>6} {:>24} {:>20}",
         "tier", "body", "real-time factor", "ns/sample"
     );
-    for body in [true, false] {
-        let mut rounded = BowedString::new(capacity, StringConstants::violin_a());
-        let (median, best) = median_and_best(SCENE_RUNS, || scene_run(&mut rounded, body));
-        print_scene_row("rounded corner", body, median, best, scene_samples);
-        let mut table = BowTableString::new(capacity, StringConstants::violin_a());
-        let (median, best) = median_and_best(SCENE_RUNS, || scene_run(&mut table, body));
-        print_scene_row("bow table", body, median, best, scene_samples);
+    for (per_sample, mode) in [(false, "process"), (true, "next_sample")] {
+        for body in [true, false] {
+            let mut rounded = BowedString::new(capacity, StringConstants::violin_a());
+            let (median, best) =
+                median_and_best(SCENE_RUNS, || scene_run(&mut rounded, body, per_sample));
+            let name = format!("rounded corner, {mode}");
+            print_scene_row(&name, body, median, best, scene_samples);
+            let mut table = BowTableString::new(capacity, StringConstants::violin_a());
+            let (median, best) =
+                median_and_best(SCENE_RUNS, || scene_run(&mut table, body, per_sample));
+            let name = format!("bow table, {mode}");
+            print_scene_row(&name, body, median, best, scene_samples);
+        }
     }
 
     println!();
