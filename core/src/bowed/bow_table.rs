@@ -152,6 +152,14 @@ impl BowTableString {
         self.neck_delay.samples() + self.bridge_delay.samples() + STRING_FILTER_DELAY_SAMPLES
     }
 
+    /// `pitch_hz` clamped to [lowest pitch of the capacity, sample rate / 4].
+    fn clamped_pitch_hz(&self, pitch_hz: f64) -> f64 {
+        // min/max, not clamp: a capacity whose lowest pitch exceeds f_s/4 must not panic.
+        pitch_hz
+            .min(0.25 * self.sample_rate_hz)
+            .max(self.capacity.lowest_pitch_hz)
+    }
+
     fn update_delays(&mut self) {
         let period = self.sample_rate_hz / self.pitch_hz;
         let line_total = period - STRING_FILTER_DELAY_SAMPLES;
@@ -167,7 +175,9 @@ impl BowedVoice for BowTableString {
         self.capacity.check_sample_rate(sample_rate_hz)?;
         self.sample_rate_hz = sample_rate_hz;
         self.body.prepare(sample_rate_hz);
-        self.set_pitch_hz(self.pitch_hz);
+        // The delays in samples change with the rate even where the pitch does not.
+        self.pitch_hz = self.clamped_pitch_hz(self.pitch_hz);
+        self.update_delays();
         self.reset();
         Ok(())
     }
@@ -179,14 +189,16 @@ impl BowedVoice for BowTableString {
         self.body.reset();
     }
 
-    /// Clamped to [lowest pitch of the capacity, sample rate / 4]; non-finite is ignored.
+    /// Clamped to [lowest pitch of the capacity, sample rate / 4]; non-finite is ignored. The
+    /// delays are split again only when the pitch changes (the instrument sets the controls
+    /// every sample).
     fn set_pitch_hz(&mut self, pitch_hz: f64) {
         if pitch_hz.is_finite() {
-            // min/max, not clamp: a capacity whose lowest pitch exceeds f_s/4 must not panic.
-            self.pitch_hz = pitch_hz
-                .min(0.25 * self.sample_rate_hz)
-                .max(self.capacity.lowest_pitch_hz);
-            self.update_delays();
+            let pitch_hz = self.clamped_pitch_hz(pitch_hz);
+            if pitch_hz != self.pitch_hz {
+                self.pitch_hz = pitch_hz;
+                self.update_delays();
+            }
         }
     }
 
@@ -205,8 +217,11 @@ impl BowedVoice for BowTableString {
 
     fn set_bow_position(&mut self, beta: f64) {
         if beta.is_finite() {
-            self.bow_position = beta.clamp(BOW_POSITION_RANGE.0, BOW_POSITION_RANGE.1);
-            self.update_delays();
+            let beta = beta.clamp(BOW_POSITION_RANGE.0, BOW_POSITION_RANGE.1);
+            if beta != self.bow_position {
+                self.bow_position = beta;
+                self.update_delays();
+            }
         }
     }
 

@@ -298,7 +298,7 @@ impl ReflectionCursor<'_> {
 /// A pulse has only a few taps (2 to 8 for a violin at 44.1 to 192 kHz), so a loop over a
 /// run-time count costs more in loop control than in arithmetic: the common counts get a
 /// fixed-length version that the compiler unrolls, chosen once per call by a jump.
-#[inline]
+#[inline(always)]
 fn convolve(taps: &[f64], window: &[f64]) -> f64 {
     match taps.len() {
         1 => convolve_fixed::<1>(taps, window),
