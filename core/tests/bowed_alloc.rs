@@ -66,7 +66,7 @@ fn play<V: BowedVoice>(voice: &mut V, samples: usize) -> f64 {
 }
 
 #[test]
-fn per_sample_path_does_not_allocate() {
+fn per_sample_and_block_paths_do_not_allocate() {
     let capacity = BowedCapacity::default();
     let mut rounded = BowedString::new(capacity, StringConstants::violin_a());
     let mut table = BowTableString::new(capacity, StringConstants::cello_d());
@@ -82,6 +82,18 @@ fn per_sample_path_does_not_allocate() {
     rounded.reset();
     table.reset();
     sum += play(&mut rounded, 10_000);
+    // The block path, body on and off.
+    let mut block = [0.0f32; 64];
+    for body in [true, false, true] {
+        rounded.set_body_enabled(body);
+        table.set_body_enabled(body);
+        for _ in 0..100 {
+            rounded.process(&mut block);
+            sum += f64::from(block[0]);
+            table.process(&mut block);
+            sum += f64::from(block[0]);
+        }
+    }
     let after = allocations();
 
     assert!(sum.is_finite());

@@ -167,9 +167,7 @@ impl<V: BowedVoice> BowedNote<V> {
 
 impl<V: BowedVoice> Scene for BowedNote<V> {
     fn render_block(&mut self, block: &mut [f32], _first_sample: usize) {
-        for sample in block.iter_mut() {
-            *sample = self.voice.next_sample().radiated as f32;
-        }
+        self.voice.process(block);
     }
 
     /// The bowed voices solve the bow point in closed form: no Newton iterations to report.

@@ -46,24 +46,41 @@ pub const VIOLIN_BODY: [BodyResonance; 4] = [
     },
 ];
 
+/// Resonances are filtered four at a time: one group's sections are independent lanes of the
+/// same arithmetic, which the compiler turns into vector instructions.
+const LANES: usize = 4;
+
+const GROUPS: usize = MAX_BODY_RESONANCES.div_ceil(LANES);
+
+/// Four band-pass sections side by side (structure of arrays). Lanes past the bank's count have
+/// zero coefficients and zero state, so they output exactly 0.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct Biquad {
-    b0: f64,
-    b2: f64,
-    a1: f64,
-    a2: f64,
-    s1: f64,
-    s2: f64,
+pub(crate) struct SectionGroup {
+    b0: [f64; LANES],
+    b2: [f64; LANES],
+    a1: [f64; LANES],
+    a2: [f64; LANES],
+    s1: [f64; LANES],
+    s2: [f64; LANES],
 }
 
-impl Biquad {
+impl SectionGroup {
+    /// One sample through the four sections: transposed direct form II, b1 = 0 for a
+    /// band-pass.
     #[inline]
-    fn tick(&mut self, x: f64) -> f64 {
-        // Transposed direct form II; b1 = 0 for a band-pass.
-        let y = self.b0 * x + self.s1;
-        self.s1 = -self.a1 * y + self.s2;
-        self.s2 = self.b2 * x - self.a2 * y;
+    fn tick(&mut self, x: f64) -> [f64; LANES] {
+        let mut y = [0.0; LANES];
+        for lane in 0..LANES {
+            y[lane] = self.b0[lane] * x + self.s1[lane];
+            self.s1[lane] = -self.a1[lane] * y[lane] + self.s2[lane];
+            self.s2[lane] = self.b2[lane] * x - self.a2[lane] * y[lane];
+        }
         y
+    }
+
+    fn reset(&mut self) {
+        self.s1 = [0.0; LANES];
+        self.s2 = [0.0; LANES];
     }
 }
 
@@ -71,7 +88,9 @@ impl Biquad {
 #[derive(Clone, Debug)]
 pub struct BodyFilter {
     resonances: [BodyResonance; MAX_BODY_RESONANCES],
-    sections: [Biquad; MAX_BODY_RESONANCES],
+    groups: [SectionGroup; GROUPS],
+    /// Groups holding at least one resonance.
+    active_groups: usize,
     count: usize,
     sample_rate_hz: f64,
 }
@@ -85,7 +104,8 @@ impl BodyFilter {
                 quality: 1.0,
                 gain_per_n: 0.0,
             }; MAX_BODY_RESONANCES],
-            sections: [Biquad::default(); MAX_BODY_RESONANCES],
+            groups: [SectionGroup::default(); GROUPS],
+            active_groups: 0,
             count: 0,
             sample_rate_hz,
         };
@@ -93,10 +113,12 @@ impl BodyFilter {
         filter
     }
 
-    /// Replace the resonances and recompute coefficients (state is kept).
+    /// Replace the resonances and recompute coefficients (the state of the resonances kept is
+    /// kept; that of resonances dropped is zeroed).
     pub fn set_resonances(&mut self, resonances: &[BodyResonance]) {
         self.count = resonances.len().min(MAX_BODY_RESONANCES);
         self.resonances[..self.count].copy_from_slice(&resonances[..self.count]);
+        self.active_groups = self.count.div_ceil(LANES);
         self.update_coefficients();
     }
 
@@ -107,20 +129,29 @@ impl BodyFilter {
     }
 
     fn update_coefficients(&mut self) {
-        for (section, resonance) in self.sections[..self.count]
-            .iter_mut()
-            .zip(&self.resonances[..self.count])
-        {
+        for index in 0..MAX_BODY_RESONANCES {
+            let group = &mut self.groups[index / LANES];
+            let lane = index % LANES;
+            if index >= self.count {
+                group.b0[lane] = 0.0;
+                group.b2[lane] = 0.0;
+                group.a1[lane] = 0.0;
+                group.a2[lane] = 0.0;
+                group.s1[lane] = 0.0;
+                group.s2[lane] = 0.0;
+                continue;
+            }
+            let resonance = &self.resonances[index];
             // A resonance at or above Nyquist cannot be represented: keep it just below.
             let nyquist_guard = 0.49 * self.sample_rate_hz;
             let frequency = resonance.frequency_hz.min(nyquist_guard).max(1e-3);
             let omega = 2.0 * core::f64::consts::PI * frequency / self.sample_rate_hz;
             let alpha = omega.sin() / (2.0 * resonance.quality.max(1e-3));
             let a0 = 1.0 + alpha;
-            section.b0 = resonance.gain_per_n * alpha / a0;
-            section.b2 = -section.b0;
-            section.a1 = -2.0 * omega.cos() / a0;
-            section.a2 = (1.0 - alpha) / a0;
+            group.b0[lane] = resonance.gain_per_n * alpha / a0;
+            group.b2[lane] = -group.b0[lane];
+            group.a1[lane] = -2.0 * omega.cos() / a0;
+            group.a2[lane] = (1.0 - alpha) / a0;
         }
     }
 
@@ -128,17 +159,74 @@ impl BodyFilter {
     #[inline]
     pub fn tick(&mut self, bridge_force_n: f64) -> f64 {
         let mut sum = 0.0;
-        for section in &mut self.sections[..self.count] {
-            sum += section.tick(bridge_force_n);
+        for group in &mut self.groups[..self.active_groups] {
+            // Added in resonance order; the idle lanes add exact zeros.
+            for y in group.tick(bridge_force_n) {
+                sum += y;
+            }
         }
         sum
     }
 
     /// Zero the filter states.
     pub fn reset(&mut self) {
-        for section in &mut self.sections {
-            section.s1 = 0.0;
-            section.s2 = 0.0;
+        for group in &mut self.groups {
+            group.reset();
+        }
+    }
+
+    /// How many groups of four resonances hold at least one resonance (0 to 2): the `G` of a
+    /// [`BodyRun`].
+    pub(crate) fn active_groups(&self) -> usize {
+        self.active_groups
+    }
+
+    /// A copy of the first `G` groups, for a run of samples whose filter state should live in
+    /// registers; [`Self::store_groups`] puts it back.
+    #[inline]
+    pub(crate) fn copy_groups<const G: usize>(&self) -> [SectionGroup; G] {
+        core::array::from_fn(|index| self.groups.get(index).copied().unwrap_or_default())
+    }
+
+    /// Store groups copied out by [`Self::copy_groups`].
+    #[inline]
+    pub(crate) fn store_groups<const G: usize>(&mut self, groups: &[SectionGroup; G]) {
+        for (stored, group) in self.groups.iter_mut().zip(groups) {
+            *stored = *group;
+        }
+    }
+}
+
+/// The body filter during a run of samples: `G` groups, a number fixed at compile time so that
+/// every loop unrolls, borrowed from a local copy (their state then stays in registers).
+#[derive(Debug)]
+pub(crate) struct BodyRun<'a, const G: usize> {
+    groups: &'a mut [SectionGroup; G],
+}
+
+impl<'a, const G: usize> BodyRun<'a, G> {
+    /// A run over `groups` (from [`BodyFilter::copy_groups`]).
+    #[inline]
+    pub(crate) fn new(groups: &'a mut [SectionGroup; G]) -> Self {
+        Self { groups }
+    }
+
+    /// As [`BodyFilter::tick`] (the same arithmetic in the same order).
+    #[inline]
+    pub(crate) fn tick(&mut self, bridge_force_n: f64) -> f64 {
+        let mut sum = 0.0;
+        for group in self.groups.iter_mut() {
+            for y in group.tick(bridge_force_n) {
+                sum += y;
+            }
+        }
+        sum
+    }
+
+    /// As [`BodyFilter::reset`].
+    pub(crate) fn reset(&mut self) {
+        for group in self.groups.iter_mut() {
+            group.reset();
         }
     }
 }

@@ -85,6 +85,7 @@ impl BowPoint {
     ///
     /// `string_admittance_line_n_s_m` is 2Z₀ (N s/m). Never panics; every branch returns finite
     /// values for finite inputs.
+    #[inline(always)]
     pub fn solve<F: FrictionLaw + ?Sized>(
         &mut self,
         law: &F,
@@ -111,11 +112,24 @@ impl BowPoint {
 
         let free_slip_speed = free_relative_m_s.abs();
         let slip_direction = if free_relative_m_s < 0.0 { -1.0 } else { 1.0 };
-        let outer_slip = law.outer_slip_speed(a, free_slip_speed, bow_force_n);
 
         // An inner (unstable) intersection exists exactly when stick and an outer sliding
         // intersection coexist: the line crosses the falling branch twice on its way from the
         // outer root back to the vertical segment.
+        if self.state == ContactState::Sticking && can_stick {
+            // Stuck and able to stay stuck: the branch memory keeps it there whatever the
+            // sliding branch does (most of the period in Helmholtz motion). Only whether an
+            // outer intersection exists is needed, for the count, not where it is, so the
+            // solve's square root and division are skipped.
+            let has_outer_slip = law.has_outer_slip(a, free_slip_speed, bow_force_n);
+            return BowPointSolution {
+                velocity_m_s: bow_velocity_m_s,
+                friction_force_n: sticking_force_n,
+                state: ContactState::Sticking,
+                intersections: if has_outer_slip { 3 } else { 1 },
+            };
+        }
+        let outer_slip = law.outer_slip_speed(a, free_slip_speed, bow_force_n);
         let intersections = match (can_stick, outer_slip.is_some()) {
             (true, true) => 3,
             _ => 1,

@@ -27,8 +27,9 @@
 //! pressure = clamp(F_b / `full_pressure_force_n`, 0, 1). F_b = 0 lifts the bow: the table is
 //! bypassed and the string rings down.
 
-use super::body::{BodyFilter, BodyResonance, VIOLIN_BODY};
-use super::bowed_string::{StringConstants, BOW_POSITION_RANGE};
+use super::body::{BodyFilter, BodyResonance, BodyRun, VIOLIN_BODY};
+use super::bowed_string::{all_finite, StringConstants, BOW_POSITION_RANGE};
+use super::delay_line::{DelayCursor, DelayHistory, FractionalDelay};
 use super::{BowedCapacity, BowedConfigError, BowedOutput, BowedVoice, MIN_SAMPLE_RATE_HZ};
 
 /// STK's slope for a normalised bow pressure in [0, 1]: S = 5 − 4 · pressure (seed 004).
@@ -38,59 +39,24 @@ pub fn bow_table_slope(pressure: f64) -> f64 {
     5.0 - 4.0 * pressure.clamp(0.0, 1.0)
 }
 
-/// The bow table of seed 004: min{(|Δv⁺| · S + 0.75)^−4, 1}.
+/// The bow table of seed 004: min{(|Δv⁺| · S + 0.75)^−4, 1}, its fourth power as two
+/// squarings (no `powf`).
+///
+/// On the plateau, base = |Δv⁺| S + 0.75 ≤ 1, the fourth power is ≤ 1 and the minimum is 1:
+/// it is returned without the division, which keeps the division off the sticking samples
+/// (most of the period). Off it, base > 1 gives base⁴ ≥ 1 and the quotient is already ≤ 1.
 #[inline]
 pub fn bow_table_reflection(differential_velocity: f64, slope: f64) -> f64 {
     let base = differential_velocity.abs() * slope + 0.75;
+    if base <= 1.0 {
+        return 1.0;
+    }
     let squared = base * base;
     (1.0 / (squared * squared)).min(1.0)
 }
 
 /// Default force for full STK pressure, N: a firm violin bow stroke.
 pub const DEFAULT_FULL_PRESSURE_FORCE_N: f64 = 2.0;
-
-#[derive(Clone, Debug)]
-struct DelayLine {
-    buffer: Vec<f64>,
-    mask: usize,
-    write: usize,
-}
-
-impl DelayLine {
-    fn new(max_delay_samples: f64) -> Self {
-        let size = (max_delay_samples.max(1.0).ceil() as usize + 3).next_power_of_two();
-        Self {
-            buffer: vec![0.0; size],
-            mask: size - 1,
-            write: 0,
-        }
-    }
-
-    fn max_delay_samples(&self) -> f64 {
-        (self.buffer.len() - 2) as f64
-    }
-
-    /// The input of `delay_samples` (≥ 1) ago, linearly interpolated.
-    #[inline]
-    fn read(&self, delay_samples: f64) -> f64 {
-        let whole = delay_samples.floor();
-        let fraction = delay_samples - whole;
-        let newer = self.buffer[self.write.wrapping_sub(whole as usize) & self.mask];
-        let older = self.buffer[self.write.wrapping_sub(whole as usize + 1) & self.mask];
-        newer + fraction * (older - newer)
-    }
-
-    #[inline]
-    fn push(&mut self, x: f64) {
-        self.buffer[self.write] = x;
-        self.write = (self.write + 1) & self.mask;
-    }
-
-    fn reset(&mut self) {
-        self.buffer.iter_mut().for_each(|x| *x = 0.0);
-        self.write = 0;
-    }
-}
 
 /// STK's bridge-reflection loss, gain 0.95 at low frequency.
 const STRING_FILTER_GAIN: f64 = 0.95;
@@ -108,10 +74,12 @@ pub struct BowTableString {
     sample_rate_hz: f64,
     wave_impedance_n_s_m: f64,
     full_pressure_force_n: f64,
-    neck: DelayLine,
-    bridge: DelayLine,
-    neck_delay_samples: f64,
-    bridge_delay_samples: f64,
+    neck: DelayHistory,
+    bridge: DelayHistory,
+    /// Bow → nut → bow, samples, split when the controls change.
+    neck_delay: FractionalDelay,
+    /// Bow → bridge → bow without the loss filter's sample, split when the controls change.
+    bridge_delay: FractionalDelay,
     filter_history: [f64; 2],
     body: BodyFilter,
     body_enabled: bool,
@@ -139,10 +107,10 @@ impl BowTableString {
             sample_rate_hz,
             wave_impedance_n_s_m: constants.wave_impedance_n_s_m(),
             full_pressure_force_n: DEFAULT_FULL_PRESSURE_FORCE_N,
-            neck: DelayLine::new(max_delay),
-            bridge: DelayLine::new(max_delay),
-            neck_delay_samples: 1.0,
-            bridge_delay_samples: 1.0,
+            neck: DelayHistory::new(max_delay.max(1.0).ceil() as usize + 3),
+            bridge: DelayHistory::new(max_delay.max(1.0).ceil() as usize + 3),
+            neck_delay: FractionalDelay::new(1.0, 1.0),
+            bridge_delay: FractionalDelay::new(1.0, 1.0),
             filter_history: [0.0; 2],
             body: BodyFilter::new(&VIOLIN_BODY, sample_rate_hz),
             body_enabled: true,
@@ -181,15 +149,24 @@ impl BowTableString {
 
     /// Total loop delay through both lines and the loss filter, samples.
     pub fn loop_delay_samples(&self) -> f64 {
-        self.neck_delay_samples + self.bridge_delay_samples + STRING_FILTER_DELAY_SAMPLES
+        self.neck_delay.samples() + self.bridge_delay.samples() + STRING_FILTER_DELAY_SAMPLES
+    }
+
+    /// `pitch_hz` clamped to [lowest pitch of the capacity, sample rate / 4].
+    fn clamped_pitch_hz(&self, pitch_hz: f64) -> f64 {
+        // min/max, not clamp: a capacity whose lowest pitch exceeds f_s/4 must not panic.
+        pitch_hz
+            .min(0.25 * self.sample_rate_hz)
+            .max(self.capacity.lowest_pitch_hz)
     }
 
     fn update_delays(&mut self) {
         let period = self.sample_rate_hz / self.pitch_hz;
         let line_total = period - STRING_FILTER_DELAY_SAMPLES;
-        let max_delay = self.neck.max_delay_samples();
-        self.bridge_delay_samples = (self.bow_position * line_total).clamp(1.0, max_delay);
-        self.neck_delay_samples = ((1.0 - self.bow_position) * line_total).clamp(1.0, max_delay);
+        // Both neighbours of the interpolated read must lie inside the history.
+        let max_delay = (self.neck.size() - 2) as f64;
+        self.bridge_delay = FractionalDelay::new(self.bow_position * line_total, max_delay);
+        self.neck_delay = FractionalDelay::new((1.0 - self.bow_position) * line_total, max_delay);
     }
 }
 
@@ -198,7 +175,9 @@ impl BowedVoice for BowTableString {
         self.capacity.check_sample_rate(sample_rate_hz)?;
         self.sample_rate_hz = sample_rate_hz;
         self.body.prepare(sample_rate_hz);
-        self.set_pitch_hz(self.pitch_hz);
+        // The delays in samples change with the rate even where the pitch does not.
+        self.pitch_hz = self.clamped_pitch_hz(self.pitch_hz);
+        self.update_delays();
         self.reset();
         Ok(())
     }
@@ -210,14 +189,16 @@ impl BowedVoice for BowTableString {
         self.body.reset();
     }
 
-    /// Clamped to [lowest pitch of the capacity, sample rate / 4]; non-finite is ignored.
+    /// Clamped to [lowest pitch of the capacity, sample rate / 4]; non-finite is ignored. The
+    /// delays are split again only when the pitch changes (the instrument sets the controls
+    /// every sample).
     fn set_pitch_hz(&mut self, pitch_hz: f64) {
         if pitch_hz.is_finite() {
-            // min/max, not clamp: a capacity whose lowest pitch exceeds f_s/4 must not panic.
-            self.pitch_hz = pitch_hz
-                .min(0.25 * self.sample_rate_hz)
-                .max(self.capacity.lowest_pitch_hz);
-            self.update_delays();
+            let pitch_hz = self.clamped_pitch_hz(pitch_hz);
+            if pitch_hz != self.pitch_hz {
+                self.pitch_hz = pitch_hz;
+                self.update_delays();
+            }
         }
     }
 
@@ -236,8 +217,11 @@ impl BowedVoice for BowTableString {
 
     fn set_bow_position(&mut self, beta: f64) {
         if beta.is_finite() {
-            self.bow_position = beta.clamp(BOW_POSITION_RANGE.0, BOW_POSITION_RANGE.1);
-            self.update_delays();
+            let beta = beta.clamp(BOW_POSITION_RANGE.0, BOW_POSITION_RANGE.1);
+            if beta != self.bow_position {
+                self.bow_position = beta;
+                self.update_delays();
+            }
         }
     }
 
@@ -245,16 +229,19 @@ impl BowedVoice for BowTableString {
         self.body_enabled = enabled;
     }
 
+    /// The per-sample path works on the voice's fields directly: building a block's run state
+    /// for one sample would cost more than the sample. [`Self::process`] runs the same
+    /// arithmetic (`TableRun::step`) bit for bit (tests/bowed_reference.rs).
     #[inline]
     fn next_sample(&mut self) -> BowedOutput {
-        let arriving_at_bridge = self.bridge.read(self.bridge_delay_samples);
+        let arriving_at_bridge = self.bridge.read(&self.bridge_delay);
         let [previous, before_previous] = self.filter_history;
         let filtered = STRING_FILTER_GAIN
             * (STRING_FILTER_SIDE_TAP * (arriving_at_bridge + before_previous)
                 + (1.0 - 2.0 * STRING_FILTER_SIDE_TAP) * previous);
         self.filter_history = [arriving_at_bridge, previous];
         let bridge_reflection = -filtered;
-        let nut_reflection = -self.neck.read(self.neck_delay_samples);
+        let nut_reflection = -self.neck.read(&self.neck_delay);
 
         let string_velocity = bridge_reflection + nut_reflection;
         let differential_velocity = self.bow_velocity_m_s - string_velocity;
@@ -278,11 +265,123 @@ impl BowedVoice for BowTableString {
             bow_point_velocity_m_s: string_velocity + bow_wave,
             radiated,
         };
-        if !(output.bridge_force_n.is_finite()
-            && output.bow_point_velocity_m_s.is_finite()
-            && output.radiated.is_finite())
-        {
+        if !all_finite([
+            output.bridge_force_n,
+            output.bow_point_velocity_m_s,
+            output.radiated,
+        ]) {
             self.reset();
+            return BowedOutput::default();
+        }
+        output
+    }
+
+    fn process(&mut self, radiated: &mut [f32]) {
+        match (self.body_enabled, self.body.active_groups()) {
+            (true, 1) => self.run::<1, _>(|run| run.render(radiated)),
+            (true, 2) => self.run::<2, _>(|run| run.render(radiated)),
+            _ => self.run::<0, _>(|run| run.render(radiated)),
+        }
+    }
+}
+
+impl BowTableString {
+    /// Run `work` on the voice's state taken out for a run of samples (`G` body groups; 0 when
+    /// the body is bypassed), then store the state back.
+    #[inline(always)]
+    fn run<const G: usize, R>(&mut self, work: impl FnOnce(&mut TableRun<'_, G>) -> R) -> R {
+        let mut groups = self.body.copy_groups::<G>();
+        let mut run = TableRun {
+            neck: self.neck.cursor(),
+            bridge: self.bridge.cursor(),
+            neck_delay: self.neck_delay,
+            bridge_delay: self.bridge_delay,
+            filter_history: self.filter_history,
+            body: BodyRun::new(&mut groups),
+            body_enabled: self.body_enabled,
+            bow_on: self.bow_force_n > 0.0,
+            bow_velocity_m_s: self.bow_velocity_m_s,
+            slope: self.slope,
+            wave_impedance_n_s_m: self.wave_impedance_n_s_m,
+        };
+        let result = work(&mut run);
+        let filter_history = run.filter_history;
+        // Ends the borrows: the cursors store their write positions back.
+        drop(run);
+        self.filter_history = filter_history;
+        self.body.store_groups(&groups);
+        result
+    }
+}
+
+/// The bow-table voice during a run of samples: controls fixed, delay-line positions and filter
+/// states in locals.
+struct TableRun<'a, const G: usize> {
+    neck: DelayCursor<'a>,
+    bridge: DelayCursor<'a>,
+    neck_delay: FractionalDelay,
+    bridge_delay: FractionalDelay,
+    filter_history: [f64; 2],
+    body: BodyRun<'a, G>,
+    body_enabled: bool,
+    bow_on: bool,
+    bow_velocity_m_s: f64,
+    slope: f64,
+    wave_impedance_n_s_m: f64,
+}
+
+impl<const G: usize> TableRun<'_, G> {
+    #[inline]
+    fn render(&mut self, radiated: &mut [f32]) {
+        for sample in radiated.iter_mut() {
+            *sample = self.step().radiated as f32;
+        }
+    }
+
+    /// One sample of seed 004's loop.
+    #[inline(always)]
+    fn step(&mut self) -> BowedOutput {
+        let arriving_at_bridge = self.bridge.read(&self.bridge_delay);
+        let [previous, before_previous] = self.filter_history;
+        let filtered = STRING_FILTER_GAIN
+            * (STRING_FILTER_SIDE_TAP * (arriving_at_bridge + before_previous)
+                + (1.0 - 2.0 * STRING_FILTER_SIDE_TAP) * previous);
+        self.filter_history = [arriving_at_bridge, previous];
+        let bridge_reflection = -filtered;
+        let nut_reflection = -self.neck.read(&self.neck_delay);
+
+        let string_velocity = bridge_reflection + nut_reflection;
+        let differential_velocity = self.bow_velocity_m_s - string_velocity;
+        let bow_wave = if self.bow_on {
+            differential_velocity * bow_table_reflection(differential_velocity, self.slope)
+        } else {
+            0.0
+        };
+
+        self.neck.push(bridge_reflection + bow_wave);
+        self.bridge.push(nut_reflection + bow_wave);
+
+        let bridge_force_n = self.wave_impedance_n_s_m * (arriving_at_bridge - bridge_reflection);
+        let radiated = if self.body_enabled {
+            self.body.tick(bridge_force_n)
+        } else {
+            bridge_force_n
+        };
+        let output = BowedOutput {
+            bridge_force_n,
+            bow_point_velocity_m_s: string_velocity + bow_wave,
+            radiated,
+        };
+        if !all_finite([
+            output.bridge_force_n,
+            output.bow_point_velocity_m_s,
+            output.radiated,
+        ]) {
+            // The voice's reset, on the run's state.
+            self.neck.reset();
+            self.bridge.reset();
+            self.filter_history = [0.0; 2];
+            self.body.reset();
             return BowedOutput::default();
         }
         output

@@ -39,10 +39,10 @@
 //! where R is the resistance of a dashpot bridge whose reflection coefficient −(R − Z₀)/(R + Z₀)
 //! equals the bridge pulse's −A_b.
 
-use super::body::{BodyFilter, BodyResonance, VIOLIN_BODY};
+use super::body::{BodyFilter, BodyResonance, BodyRun, VIOLIN_BODY};
 use super::bow_point::{BowPoint, BowPointSolution, ContactState};
 use super::friction::{FrictionLaw, HyperbolicFriction};
-use super::reflection::{ReflectionFunction, ReflectionPulse};
+use super::reflection::{ReflectionCursor, ReflectionFunction, ReflectionPulse};
 use super::{BowedCapacity, BowedConfigError, BowedOutput, BowedVoice, MIN_SAMPLE_RATE_HZ};
 
 /// Widest reflection pulse a voice can be given, s.
@@ -50,6 +50,25 @@ pub const MAX_PULSE_WIDTH_S: f64 = 1e-3;
 
 /// Smallest and largest bow position accepted by [`BowedString::set_bow_position`].
 pub const BOW_POSITION_RANGE: (f64, f64) = (0.001, 0.999);
+
+/// Whether every value is finite, in one test: x · 0 is ±0 for finite x and NaN for ±∞ or NaN,
+/// so the sum of the products is zero exactly when all are finite.
+#[inline(always)]
+pub(crate) fn all_finite<const N: usize>(values: [f64; N]) -> bool {
+    let mut probe = 0.0;
+    for value in values {
+        probe += value * 0.0;
+    }
+    probe == 0.0
+}
+
+/// The bow-point solution of a voice at rest: stuck, no force.
+const RESTING_SOLUTION: BowPointSolution = BowPointSolution {
+    velocity_m_s: 0.0,
+    friction_force_n: 0.0,
+    state: ContactState::Sticking,
+    intersections: 1,
+};
 
 /// The string's physical constants and its two reflection functions.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,12 +192,7 @@ impl<F: FrictionLaw> BowedString<F> {
             bow_force_n: 0.0,
             bow_velocity_m_s: 0.0,
             bow_position: 0.1,
-            last_solution: BowPointSolution {
-                velocity_m_s: 0.0,
-                friction_force_n: 0.0,
-                state: ContactState::Sticking,
-                intersections: 1,
-            },
+            last_solution: RESTING_SOLUTION,
         };
         voice.update_reflections();
         voice
@@ -237,7 +251,7 @@ impl<F: FrictionLaw> BowedString<F> {
     }
 
     /// Mutable access to the bridge-side reflection function, e.g. for Woodhouse's [σ, λ, σ].
-    /// The next pitch/position/constants change recomputes the pulse.
+    /// The next change of pitch, position, constants or sample rate recomputes the pulse.
     pub fn bridge_reflection_mut(&mut self) -> &mut ReflectionFunction {
         &mut self.bridge
     }
@@ -274,6 +288,14 @@ impl<F: FrictionLaw> BowedString<F> {
             / (2.0 * resistance * self.bow_position * self.bow_position * fall)
     }
 
+    /// `pitch_hz` clamped to [lowest pitch of the capacity, sample rate / 4].
+    fn clamped_pitch_hz(&self, pitch_hz: f64) -> f64 {
+        // min/max, not clamp: a capacity whose lowest pitch exceeds f_s/4 must not panic.
+        pitch_hz
+            .min(0.25 * self.sample_rate_hz)
+            .max(self.capacity.lowest_pitch_hz)
+    }
+
     fn update_reflections(&mut self) {
         let period_samples = self.sample_rate_hz / self.pitch_hz;
         let bridge_delay = self.bow_position * period_samples;
@@ -295,7 +317,9 @@ impl<F: FrictionLaw> BowedVoice for BowedString<F> {
         self.capacity.check_sample_rate(sample_rate_hz)?;
         self.sample_rate_hz = sample_rate_hz;
         self.body.prepare(sample_rate_hz);
-        self.set_pitch_hz(self.pitch_hz);
+        // The delays in samples change with the rate even where the pitch does not.
+        self.pitch_hz = self.clamped_pitch_hz(self.pitch_hz);
+        self.update_reflections();
         self.reset();
         Ok(())
     }
@@ -305,22 +329,19 @@ impl<F: FrictionLaw> BowedVoice for BowedString<F> {
         self.nut.reset();
         self.bow.reset();
         self.body.reset();
-        self.last_solution = BowPointSolution {
-            velocity_m_s: 0.0,
-            friction_force_n: 0.0,
-            state: ContactState::Sticking,
-            intersections: 1,
-        };
+        self.last_solution = RESTING_SOLUTION;
     }
 
-    /// Clamped to [lowest pitch of the capacity, sample rate / 4]; non-finite is ignored.
+    /// Clamped to [lowest pitch of the capacity, sample rate / 4]; non-finite is ignored. The
+    /// reflection functions are recomputed only when the pitch changes (the instrument sets the
+    /// controls every sample).
     fn set_pitch_hz(&mut self, pitch_hz: f64) {
         if pitch_hz.is_finite() {
-            // min/max, not clamp: a capacity whose lowest pitch exceeds f_s/4 must not panic.
-            self.pitch_hz = pitch_hz
-                .min(0.25 * self.sample_rate_hz)
-                .max(self.capacity.lowest_pitch_hz);
-            self.update_reflections();
+            let pitch_hz = self.clamped_pitch_hz(pitch_hz);
+            if pitch_hz != self.pitch_hz {
+                self.pitch_hz = pitch_hz;
+                self.update_reflections();
+            }
         }
     }
 
@@ -339,11 +360,15 @@ impl<F: FrictionLaw> BowedVoice for BowedString<F> {
     }
 
     /// Clamped to [`BOW_POSITION_RANGE`]; non-finite is ignored. Where β/f₀ is shorter than
-    /// one sample the bridge-side delay is held at one sample (the pitch then runs sharp).
+    /// one sample the bridge-side delay is held at one sample (the pitch then runs sharp). The
+    /// reflection functions are recomputed only when the position changes.
     fn set_bow_position(&mut self, beta: f64) {
         if beta.is_finite() {
-            self.bow_position = beta.clamp(BOW_POSITION_RANGE.0, BOW_POSITION_RANGE.1);
-            self.update_reflections();
+            let beta = beta.clamp(BOW_POSITION_RANGE.0, BOW_POSITION_RANGE.1);
+            if beta != self.bow_position {
+                self.bow_position = beta;
+                self.update_reflections();
+            }
         }
     }
 
@@ -351,6 +376,9 @@ impl<F: FrictionLaw> BowedVoice for BowedString<F> {
         self.body_enabled = enabled;
     }
 
+    /// The per-sample path works on the voice's fields directly: building a block's run state
+    /// for one sample would cost more than the sample. [`Self::process`] runs the same
+    /// arithmetic (`RoundedRun::step`) bit for bit (tests/bowed_reference.rs).
     #[inline]
     fn next_sample(&mut self) -> BowedOutput {
         let z0 = self.wave_impedance_n_s_m;
@@ -372,7 +400,7 @@ impl<F: FrictionLaw> BowedVoice for BowedString<F> {
         let outgoing_nut = incoming_bridge + bow_wave;
 
         // Read before pushing: the wave sent towards the bridge one round trip ago.
-        let arriving_at_bridge = self.bridge.outgoing_delayed(self.bridge.delay_samples());
+        let arriving_at_bridge = self.bridge.outgoing_round_trip_ago();
         self.bridge.push(outgoing_bridge);
         self.nut.push(outgoing_nut);
 
@@ -388,13 +416,136 @@ impl<F: FrictionLaw> BowedVoice for BowedString<F> {
             bow_point_velocity_m_s: solution.velocity_m_s,
             radiated,
         };
-        if !(output.bridge_force_n.is_finite()
-            && output.bow_point_velocity_m_s.is_finite()
-            && output.radiated.is_finite()
-            && outgoing_bridge.is_finite()
-            && outgoing_nut.is_finite())
-        {
+        if !all_finite([
+            output.bridge_force_n,
+            output.bow_point_velocity_m_s,
+            output.radiated,
+            outgoing_bridge,
+            outgoing_nut,
+        ]) {
             self.reset();
+            return BowedOutput::default();
+        }
+        self.last_solution = solution;
+        output
+    }
+
+    fn process(&mut self, radiated: &mut [f32]) {
+        match (self.body_enabled, self.body.active_groups()) {
+            (true, 1) => self.run::<1, _>(|run| run.render(radiated)),
+            (true, 2) => self.run::<2, _>(|run| run.render(radiated)),
+            _ => self.run::<0, _>(|run| run.render(radiated)),
+        }
+    }
+}
+
+impl<F: FrictionLaw> BowedString<F> {
+    /// Run `work` on the voice's state taken out for a run of samples (`G` body groups; 0 when
+    /// the body is bypassed), then store the state back.
+    #[inline(always)]
+    fn run<const G: usize, R>(&mut self, work: impl FnOnce(&mut RoundedRun<'_, F, G>) -> R) -> R {
+        let mut groups = self.body.copy_groups::<G>();
+        let z0 = self.wave_impedance_n_s_m;
+        let mut run = RoundedRun {
+            friction: &self.friction,
+            bridge: self.bridge.cursor(),
+            nut: self.nut.cursor(),
+            bow: self.bow,
+            body: BodyRun::new(&mut groups),
+            body_enabled: self.body_enabled,
+            wave_impedance_n_s_m: z0,
+            line_slope_n_s_m: 2.0 * z0,
+            bow_force_n: self.bow_force_n,
+            bow_velocity_m_s: self.bow_velocity_m_s,
+            last_solution: self.last_solution,
+        };
+        let result = work(&mut run);
+        let (bow, last_solution) = (run.bow, run.last_solution);
+        // Ends the borrows: the cursors store their write positions back.
+        drop(run);
+        self.bow = bow;
+        self.body.store_groups(&groups);
+        self.last_solution = last_solution;
+        result
+    }
+}
+
+/// The rounded-corner voice during a run of samples: controls fixed, delay-line positions, the
+/// branch memory and the filter states in locals.
+struct RoundedRun<'a, F, const G: usize> {
+    friction: &'a F,
+    bridge: ReflectionCursor<'a>,
+    nut: ReflectionCursor<'a>,
+    bow: BowPoint,
+    body: BodyRun<'a, G>,
+    body_enabled: bool,
+    wave_impedance_n_s_m: f64,
+    /// 2Z₀, N s/m.
+    line_slope_n_s_m: f64,
+    bow_force_n: f64,
+    bow_velocity_m_s: f64,
+    last_solution: BowPointSolution,
+}
+
+impl<F: FrictionLaw, const G: usize> RoundedRun<'_, F, G> {
+    #[inline]
+    fn render(&mut self, radiated: &mut [f32]) {
+        for sample in radiated.iter_mut() {
+            *sample = self.step().radiated as f32;
+        }
+    }
+
+    /// One sample of the module doc's equations.
+    #[inline(always)]
+    fn step(&mut self) -> BowedOutput {
+        let z0 = self.wave_impedance_n_s_m;
+        let line_slope = self.line_slope_n_s_m;
+
+        let incoming_bridge = self.bridge.incoming();
+        let incoming_nut = self.nut.incoming();
+        let free_velocity = incoming_bridge + incoming_nut;
+
+        let solution = self.bow.solve(
+            self.friction,
+            line_slope,
+            free_velocity,
+            self.bow_velocity_m_s,
+            self.bow_force_n,
+        );
+        let bow_wave = solution.friction_force_n / line_slope;
+        let outgoing_bridge = incoming_nut + bow_wave;
+        let outgoing_nut = incoming_bridge + bow_wave;
+
+        // Read before pushing: the wave sent towards the bridge one round trip ago.
+        let arriving_at_bridge = self.bridge.outgoing_round_trip_ago();
+        self.bridge.push(outgoing_bridge);
+        self.nut.push(outgoing_nut);
+
+        let bridge_force_n = z0 * (arriving_at_bridge - incoming_bridge);
+        let radiated = if self.body_enabled {
+            self.body.tick(bridge_force_n)
+        } else {
+            bridge_force_n
+        };
+
+        let output = BowedOutput {
+            bridge_force_n,
+            bow_point_velocity_m_s: solution.velocity_m_s,
+            radiated,
+        };
+        if !all_finite([
+            output.bridge_force_n,
+            output.bow_point_velocity_m_s,
+            output.radiated,
+            outgoing_bridge,
+            outgoing_nut,
+        ]) {
+            // The voice's reset, on the run's state.
+            self.bridge.reset();
+            self.nut.reset();
+            self.bow.reset();
+            self.body.reset();
+            self.last_solution = RESTING_SOLUTION;
             return BowedOutput::default();
         }
         self.last_solution = solution;

@@ -57,6 +57,19 @@ pub trait FrictionLaw {
     ) -> Option<f64> {
         outer_slip_speed_by_newton(self, line_slope_n_s_m, free_slip_speed_m_s, bow_force_n)
     }
+
+    /// Whether [`Self::outer_slip_speed`] is `Some`, for a sticking contact that stays stuck and
+    /// needs only the count of intersections, not the slip speed. Laws with a cheaper test than
+    /// solving override it.
+    fn has_outer_slip(
+        &self,
+        line_slope_n_s_m: f64,
+        free_slip_speed_m_s: f64,
+        bow_force_n: f64,
+    ) -> bool {
+        self.outer_slip_speed(line_slope_n_s_m, free_slip_speed_m_s, bow_force_n)
+            .is_some()
+    }
 }
 
 /// Iteration cap of [`outer_slip_speed_by_newton`].
@@ -192,6 +205,38 @@ impl FrictionLaw for HyperbolicFriction {
             None
         }
     }
+
+    /// The quadratic's sign pattern, without its square root or division: with a > 0 and a
+    /// real root, the larger root is positive when b < 0 (−b + √D > 0) or else when c < 0 (the
+    /// roots then have opposite signs). The sign argument needs the quotients in
+    /// [`Self::outer_slip_speed`] not to underflow, so a, |b| and |c| must lie in [1e−150, 1e150]
+    /// (they are of order 0.01 to 100 for real strings); outside that, it solves.
+    #[inline]
+    fn has_outer_slip(
+        &self,
+        line_slope_n_s_m: f64,
+        free_slip_speed_m_s: f64,
+        bow_force_n: f64,
+    ) -> bool {
+        let a = line_slope_n_s_m;
+        let x = free_slip_speed_m_s;
+        if x.is_nan() || x <= 0.0 {
+            return false;
+        }
+        let v0 = self.decay_velocity_m_s;
+        let b = a * (v0 - x) + bow_force_n * self.dynamic_coefficient;
+        let c = v0 * (bow_force_n * self.static_coefficient - a * x);
+        // `&` and `|`, not `&&` and `||`: flags combined without a branch each.
+        let moderate = |value: f64| {
+            let magnitude = value.abs();
+            (1e-150..=1e150).contains(&magnitude)
+        };
+        if !((a > 0.0) & moderate(a) & moderate(b) & moderate(c)) {
+            return self.outer_slip_speed(a, x, bow_force_n).is_some();
+        }
+        let discriminant = b * b - 4.0 * a * c;
+        (discriminant >= 0.0) & ((b < 0.0) | (c < 0.0))
+    }
 }
 
 /// An exponential falling curve, μ(w) = μ_d + (μ_s − μ_d) exp(−w / v₀): a second law to show
@@ -308,6 +353,37 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn existence_test_agrees_with_the_solve() {
+        let law = HyperbolicFriction::default();
+        let values = [
+            0.0, 1e-200, 1e-12, 1e-4, 0.02, 0.1, 0.3, 0.5, 1.2, 2.0, 5.0, 40.0, 1e12, 1e200,
+        ];
+        let mut seen = [0usize; 2];
+        for &a in &values[1..] {
+            for &force in &values {
+                for &x in &values {
+                    let solved = law.outer_slip_speed(a, x, force).is_some();
+                    assert_eq!(
+                        law.has_outer_slip(a, x, force),
+                        solved,
+                        "a={a} F={force} x={x}"
+                    );
+                    seen[solved as usize] += 1;
+                }
+            }
+        }
+        // Across the tangency, where the discriminant crosses zero (x ≈ 1.357 for a = 0.4 and
+        // F_b = 1, the capture point of the hysteresis test in bow_point.rs).
+        for i in 0..20_000 {
+            let x = 1.0 + 1e-4 * i as f64;
+            let solved = law.outer_slip_speed(0.4, x, 1.0).is_some();
+            assert_eq!(law.has_outer_slip(0.4, x, 1.0), solved, "x={x}");
+            seen[solved as usize] += 1;
+        }
+        assert!(seen[0] > 100 && seen[1] > 100, "{seen:?}");
     }
 
     #[test]

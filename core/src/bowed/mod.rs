@@ -3,6 +3,8 @@
 //!
 //! One file per part:
 //!
+//! - [`delay_line`]: the mirrored power-of-two history both tiers read at fixed and fractional
+//!   delays;
 //! - [`reflection`]: the bridge-side and nut/finger-side reflection functions (Woodhouse 1993,
 //!   section 3.1), with fractional delays and Raman's single tap as the limiting case;
 //! - [`friction`]: the friction law (hyperbolic by default) returning value and slope;
@@ -19,6 +21,7 @@ pub mod body;
 pub mod bow_point;
 pub mod bow_table;
 pub mod bowed_string;
+pub mod delay_line;
 pub mod friction;
 pub mod instrument;
 pub mod reflection;
@@ -138,4 +141,14 @@ pub trait BowedVoice {
     fn set_body_enabled(&mut self, enabled: bool);
     /// Advance one sample. Allocation-free; NaN/Inf silences and resets the voice.
     fn next_sample(&mut self) -> BowedOutput;
+
+    /// Advance `radiated.len()` samples with the controls as they are, writing the radiated
+    /// signal: the same samples as that many [`Self::next_sample`] calls, bit for bit, but the
+    /// voices keep their state in registers across the block instead of storing and reloading
+    /// it every sample. Allocation-free.
+    fn process(&mut self, radiated: &mut [f32]) {
+        for sample in radiated.iter_mut() {
+            *sample = self.next_sample().radiated as f32;
+        }
+    }
 }

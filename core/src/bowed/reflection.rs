@@ -25,6 +25,8 @@
 //! (cos²(π/4) = 1/2 gives σ = λ/2 before normalisation; any [σ, λ, σ] can be set directly with
 //! [`ReflectionFunction::set_taps`]).
 
+use super::delay_line::{DelayCursor, DelayHistory, FractionalDelay};
+
 /// Parameters of one reflection function's pulse.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReflectionPulse {
@@ -37,17 +39,25 @@ pub struct ReflectionPulse {
 
 /// A reflection function with the history of outgoing waves it convolves.
 ///
-/// `new()` sizes the ring buffer and the tap storage for the longest delay and widest pulse the
-/// voice can ask for; `set_*` and the per-sample methods never allocate.
+/// `new()` sizes the history and the tap storage for the longest delay and widest pulse the
+/// voice can ask for; `set_*` and the per-sample methods never allocate. What changes only with
+/// the controls is prepared when they change, not per sample: the raised-cosine shape (its
+/// `cos` calls) only when the width or the tap count changes, the split of the round-trip delay
+/// into whole samples and a fraction whenever the delay changes.
 #[derive(Clone, Debug)]
 pub struct ReflectionFunction {
-    history: Vec<f64>,
-    mask: usize,
-    write: usize,
+    history: DelayHistory,
     taps: Vec<f64>,
     tap_count: usize,
     first_tap_delay: usize,
     delay_samples: f64,
+    round_trip: FractionalDelay,
+    /// The unnormalised raised-cosine values of the last `set_pulse`, kept so that a change of
+    /// delay alone (a pitch glide, vibrato, a moving bow) does not recompute them.
+    shape: Vec<f64>,
+    shape_sum: f64,
+    shape_half_width: f64,
+    shape_half_count: usize,
 }
 
 impl ReflectionFunction {
@@ -56,17 +66,20 @@ impl ReflectionFunction {
     pub fn new(max_delay_samples: f64, max_width_samples: f64) -> Self {
         let max_taps = max_width_samples.max(0.0).ceil() as usize + 3;
         let longest = max_delay_samples.max(1.0).ceil() as usize + max_taps + 2;
-        let size = longest.next_power_of_two();
         let mut taps = vec![0.0; max_taps];
         taps[0] = -1.0;
         Self {
-            history: vec![0.0; size],
-            mask: size - 1,
-            write: 0,
+            history: DelayHistory::new(longest),
             taps,
             tap_count: 1,
             first_tap_delay: 1,
             delay_samples: 1.0,
+            round_trip: FractionalDelay::new(1.0, 1.0),
+            shape: vec![0.0; max_taps],
+            shape_sum: 0.0,
+            // NaN: no shape cached yet.
+            shape_half_width: f64::NAN,
+            shape_half_count: 0,
         }
     }
 
@@ -77,7 +90,7 @@ impl ReflectionFunction {
 
     /// Longest delay (samples) the history can serve for a pulse of `tap_count` taps.
     pub fn max_delay_samples(&self) -> f64 {
-        (self.history.len() - self.taps.len() - 2) as f64
+        (self.history.size() - self.taps.len() - 2) as f64
     }
 
     /// Centre the pulse on `delay_samples` (≥ 1) with full width `width_samples` and area `area`.
@@ -113,44 +126,52 @@ impl ReflectionFunction {
         half_count = half_count.min(capacity_half).min(whole_delay - 1);
 
         let symmetric_count = 2 * half_count + 1;
-        let mut base_sum = 0.0;
-        for index in 0..symmetric_count {
-            let k = index as f64 - half_count as f64;
-            let value = if half_count == 0 {
-                1.0
-            } else {
-                let phase = core::f64::consts::PI * k / (2.0 * half_width);
-                let c = phase.cos();
-                c * c
-            };
-            self.taps[index] = value;
-            base_sum += value;
+        if half_width != self.shape_half_width || half_count != self.shape_half_count {
+            let mut sum = 0.0;
+            for (index, value) in self.shape[..symmetric_count].iter_mut().enumerate() {
+                let k = index as f64 - half_count as f64;
+                *value = if half_count == 0 {
+                    1.0
+                } else {
+                    let phase = core::f64::consts::PI * k / (2.0 * half_width);
+                    let c = phase.cos();
+                    c * c
+                };
+                sum += *value;
+            }
+            self.shape_sum = sum;
+            self.shape_half_width = half_width;
+            self.shape_half_count = half_count;
         }
         let area = if area.is_finite() { area } else { 0.0 };
-        let gain = -area / base_sum;
+        let gain = -area / self.shape_sum;
         // Linear interpolation towards one sample more delay: tap j gets (1 − φ) base[j] +
-        // φ base[j − 1]. Walk backwards so base[j − 1] is still unmodified when read.
-        self.taps[symmetric_count] = 0.0;
-        for index in (0..=symmetric_count).rev() {
+        // φ base[j − 1], with base zero outside 0..symmetric_count.
+        for index in 0..=symmetric_count {
             let current = if index < symmetric_count {
-                self.taps[index]
+                self.shape[index]
             } else {
                 0.0
             };
-            let previous = if index > 0 { self.taps[index - 1] } else { 0.0 };
+            let previous = if index > 0 {
+                self.shape[index - 1]
+            } else {
+                0.0
+            };
             self.taps[index] = gain * ((1.0 - fraction) * current + fraction * previous);
         }
         self.tap_count = symmetric_count + 1;
         self.first_tap_delay = whole_delay - half_count;
-        self.delay_samples = delay;
+        self.set_delay(delay);
     }
 
     /// Set the taps directly: `taps[j]` applies at delay `first_tap_delay + j` (≥ 1). For
     /// reproducing a paper's discrete reflection function such as eq. 22's [σ, λ, σ] (with its
-    /// sign). Extra taps beyond capacity are ignored; the centroid becomes the reported delay.
+    /// sign). Extra taps beyond capacity are ignored, and the first delay is lowered if the last
+    /// tap would reach beyond the history; the centroid becomes the reported delay.
     pub fn set_taps(&mut self, first_tap_delay: usize, taps: &[f64]) {
         let count = taps.len().min(self.taps.len()).max(1);
-        let first = first_tap_delay.max(1);
+        let first = first_tap_delay.max(1).min(self.history.size() + 1 - count);
         let mut sum = 0.0;
         let mut moment = 0.0;
         for j in 0..count {
@@ -161,11 +182,16 @@ impl ReflectionFunction {
         }
         self.tap_count = count;
         self.first_tap_delay = first;
-        self.delay_samples = if sum != 0.0 {
+        self.set_delay(if sum != 0.0 {
             moment / sum
         } else {
             first as f64
-        };
+        });
+    }
+
+    fn set_delay(&mut self, delay_samples: f64) {
+        self.delay_samples = delay_samples;
+        self.round_trip = FractionalDelay::new(delay_samples, self.max_delay_samples());
     }
 
     /// The active taps, earliest delay first.
@@ -186,39 +212,127 @@ impl ReflectionFunction {
     /// i(n) = Σ_k r(k) o(n − k), over the outgoing waves pushed before this sample.
     #[inline]
     pub fn incoming(&self) -> f64 {
-        let mut sum = 0.0;
-        let mut read = self.write.wrapping_sub(self.first_tap_delay) & self.mask;
-        for &tap in &self.taps[..self.tap_count] {
-            sum += tap * self.history[read];
-            // Each further tap reaches one sample further into the past.
-            read = read.wrapping_sub(1) & self.mask;
-        }
-        sum
+        let window = self.history.window(self.first_tap_delay, self.tap_count);
+        convolve(&self.taps[..self.tap_count], window)
     }
 
     /// The outgoing wave of `delay_samples` ago (≥ 1), linearly interpolated.
     #[inline]
     pub fn outgoing_delayed(&self, delay_samples: f64) -> f64 {
-        let delay = delay_samples.clamp(1.0, self.max_delay_samples());
-        let whole = delay.floor();
-        let fraction = delay - whole;
-        let newer = self.history[self.write.wrapping_sub(whole as usize) & self.mask];
-        let older = self.history[self.write.wrapping_sub(whole as usize + 1) & self.mask];
-        newer + fraction * (older - newer)
+        self.history.read(&FractionalDelay::new(
+            delay_samples,
+            self.max_delay_samples(),
+        ))
+    }
+
+    /// The outgoing wave of one round trip ([`Self::delay_samples`]) ago, linearly
+    /// interpolated: [`Self::outgoing_delayed`] at the centre delay, with the delay split when it
+    /// was set rather than per sample.
+    #[inline]
+    pub fn outgoing_round_trip_ago(&self) -> f64 {
+        self.history.read(&self.round_trip)
     }
 
     /// Store this sample's outgoing wave.
     #[inline]
     pub fn push(&mut self, outgoing: f64) {
-        self.history[self.write] = outgoing;
-        self.write = (self.write + 1) & self.mask;
+        self.history.push(outgoing);
     }
 
     /// Zero the history (taps are kept).
     pub fn reset(&mut self) {
-        self.history.iter_mut().for_each(|x| *x = 0.0);
-        self.write = 0;
+        self.history.reset();
     }
+
+    /// The function for a run of samples with its taps fixed, its history's write position in
+    /// a register (see [`DelayHistory::cursor`]).
+    #[inline]
+    pub fn cursor(&mut self) -> ReflectionCursor<'_> {
+        ReflectionCursor {
+            taps: &self.taps[..self.tap_count],
+            first_tap_delay: self.first_tap_delay,
+            round_trip: self.round_trip,
+            history: self.history.cursor(),
+        }
+    }
+}
+
+/// A [`ReflectionFunction`] borrowed for a run of samples: the same per-sample methods.
+#[derive(Debug)]
+pub struct ReflectionCursor<'a> {
+    taps: &'a [f64],
+    first_tap_delay: usize,
+    round_trip: FractionalDelay,
+    history: DelayCursor<'a>,
+}
+
+impl ReflectionCursor<'_> {
+    /// As [`ReflectionFunction::incoming`].
+    #[inline(always)]
+    pub fn incoming(&self) -> f64 {
+        let window = self.history.window(self.first_tap_delay, self.taps.len());
+        convolve(self.taps, window)
+    }
+
+    /// As [`ReflectionFunction::outgoing_round_trip_ago`].
+    #[inline]
+    pub fn outgoing_round_trip_ago(&self) -> f64 {
+        self.history.read(&self.round_trip)
+    }
+
+    /// As [`ReflectionFunction::push`].
+    #[inline]
+    pub fn push(&mut self, outgoing: f64) {
+        self.history.push(outgoing);
+    }
+
+    /// As [`ReflectionFunction::reset`].
+    pub fn reset(&mut self) {
+        self.history.reset();
+    }
+}
+
+/// Σ_j taps[j] · window[len − 1 − j]: the window runs oldest first, and tap 0 (the shortest
+/// delay) meets its newest value. Added in tap order.
+///
+/// A pulse has only a few taps (2 to 8 for a violin at 44.1 to 192 kHz), so a loop over a
+/// run-time count costs more in loop control than in arithmetic: the common counts get a
+/// fixed-length version that the compiler unrolls, chosen once per call by a jump.
+#[inline(always)]
+fn convolve(taps: &[f64], window: &[f64]) -> f64 {
+    match taps.len() {
+        1 => convolve_fixed::<1>(taps, window),
+        2 => convolve_fixed::<2>(taps, window),
+        3 => convolve_fixed::<3>(taps, window),
+        4 => convolve_fixed::<4>(taps, window),
+        5 => convolve_fixed::<5>(taps, window),
+        6 => convolve_fixed::<6>(taps, window),
+        7 => convolve_fixed::<7>(taps, window),
+        8 => convolve_fixed::<8>(taps, window),
+        _ => convolve_any(taps, window),
+    }
+}
+
+#[inline(always)]
+fn convolve_fixed<const N: usize>(taps: &[f64], window: &[f64]) -> f64 {
+    match (taps.first_chunk::<N>(), window.last_chunk::<N>()) {
+        (Some(taps), Some(window)) => {
+            let mut sum = 0.0;
+            for j in 0..N {
+                sum += taps[j] * window[N - 1 - j];
+            }
+            sum
+        }
+        _ => convolve_any(taps, window),
+    }
+}
+
+fn convolve_any(taps: &[f64], window: &[f64]) -> f64 {
+    let mut sum = 0.0;
+    for (&tap, &past) in taps.iter().zip(window.iter().rev()) {
+        sum += tap * past;
+    }
+    sum
 }
 
 #[cfg(test)]
