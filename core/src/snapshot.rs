@@ -95,24 +95,25 @@ impl<const CAPACITY: usize> BarrierView<CAPACITY> {
 pub const MODAL_VIEW_INTERVALS: usize = 200;
 const _: () = assert!(MODAL_VIEW_INTERVALS < MAX_STRING_NODES);
 
-/// A modal string's contact points `range` as a barrier view: `a_i = h_i − y_i`, so the string
-/// there is `h_i − a_i`.
+/// A modal string's contact points `range` as a barrier view, with the string's displacement
+/// there from its modes (the far points' gaps are only bounded between exact evaluations).
 fn fill_points<const CAPACITY: usize>(
     view: &mut BarrierView<CAPACITY>,
-    points: &crate::tanpura::modal::points::ContactPoints,
-    gaps_m: &[f64],
+    string: &ModalString<f32>,
     range: std::ops::Range<usize>,
 ) {
+    let points = string.points();
     let (len, stride) = fit(range.len(), CAPACITY);
     view.len = len;
     view.stride = stride;
     for held in 0..len {
         let i = range.start + held * stride;
-        let height = points.heights_m[i];
-        view.positions_m[held] = points.positions_m[i] as f32;
+        let (position, height) = (points.positions_m[i], points.heights_m[i]);
+        let displacement = string.displacement_at_m(position);
+        view.positions_m[held] = position as f32;
         view.heights_m[held] = height as f32;
-        view.string_m[held] = (height - gaps_m[i]) as f32;
-        view.in_contact[held] = gaps_m[i] > 0.0;
+        view.string_m[held] = displacement as f32;
+        view.in_contact[held] = height - displacement > 0.0;
     }
 }
 
@@ -295,10 +296,9 @@ impl TanpuraSnapshot {
             self.rest_displacement_m[node] = string.rest_displacement_at_m(x) as f32;
         }
         let points = string.points();
-        let gaps = string.gaps_m();
         let bridge_points = points.bridge_count();
-        fill_points(&mut self.bridge, points, gaps, 0..bridge_points);
-        fill_points(&mut self.thread, points, gaps, bridge_points..points.len());
+        fill_points(&mut self.bridge, string, 0..bridge_points);
+        fill_points(&mut self.thread, string, bridge_points..points.len());
         self.max_penetration_m = string.max_penetration_m();
         self.nut_force_n = string.nut_force_n();
         self.rest_nut_force_n = string.rest_nut_force_n();
@@ -442,7 +442,6 @@ pub(crate) mod tests {
             );
         }
         let points = string.points();
-        let gaps = string.gaps_m();
         let bridge = points.bridge_count();
         assert_eq!(snapshot.bridge.len, bridge);
         assert_eq!(snapshot.thread.len, points.len() - bridge);
@@ -455,8 +454,9 @@ pub(crate) mod tests {
             let (position, height, string_m, contact) = view.point(held);
             assert_eq!(position, points.positions_m[i] as f32);
             assert_eq!(height, points.heights_m[i] as f32);
-            assert_eq!(string_m, (points.heights_m[i] - gaps[i]) as f32);
-            assert_eq!(contact, gaps[i] > 0.0);
+            let y = string.displacement_at_m(points.positions_m[i]);
+            assert_eq!(string_m, y as f32);
+            assert_eq!(contact, points.heights_m[i] - y > 0.0);
         }
         assert_eq!(snapshot.nut_force_n, string.nut_force_n());
         assert_eq!(snapshot.bridge_force_n, string.bridge_force_n());

@@ -13,8 +13,10 @@ use crate::newton::{NewtonSettings, NewtonStats};
 /// The string a tier runs.
 #[derive(Debug, Clone)]
 pub enum TierString {
-    FiniteDifference(FdString),
-    Modal(ModalString<f32>),
+    /// Both boxed (the strings differ in size by kilobytes); the boxes are made once, when the
+    /// voice is built.
+    FiniteDifference(Box<FdString>),
+    Modal(Box<ModalString<f32>>),
 }
 
 impl TierString {

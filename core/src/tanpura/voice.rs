@@ -358,9 +358,9 @@ impl TanpuraVoice {
             .iter()
             .map(|&quality| {
                 if let Some(config) = build.modal_config_at(quality, output_sample_rate_hz) {
-                    TierString::Modal(ModalString::new(config))
+                    TierString::Modal(Box::new(ModalString::new(config)))
                 } else if let Some(config) = build.fd_config_at(quality, output_sample_rate_hz) {
-                    TierString::FiniteDifference(FdString::new(config))
+                    TierString::FiniteDifference(Box::new(FdString::new(config)))
                 } else {
                     unreachable!("every tier is modal or FD")
                 }

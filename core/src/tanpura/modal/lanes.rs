@@ -1,8 +1,8 @@
 //! The three loops over the modes, as SIMD kernels dispatched at run time.
 //!
 //! The modal step (`docs/modal-tanpura.md`, eq. M1) spends its time in three passes over the
-//! contiguous mode arrays: the free step `s = a p − b r`, the free motion of the contact points
-//! `Δu_i = Ψ_i · s` (one dot product per point), and the update that adds the contact forces,
+//! contiguous mode arrays: the free step `s = a p − b r`, the free motion of the contact points near
+//! contact `Δu_i = Ψ_i · s` (one dot product per point), and the update that adds the contact forces,
 //! advances the state and forms the nut force. Each pass is a [`pulp::WithSimd`] kernel:
 //! [`pulp::Arch`] picks AVX-512, AVX2+FMA or scalar code once per process from the CPU, so the one
 //! generic x86-64 binary runs the widest unit the machine has (pulp comes with faer, so it adds
@@ -157,85 +157,6 @@ impl<T: Real> WithSimd for FreeStep<'_, T> {
         for ((s, (a, b)), (r, p)) in modes {
             *s = T::sub(simd, T::mul(simd, *a, *p), T::mul(simd, *b, *r));
         }
-    }
-}
-
-/// The motion of every point from a mode-major copy of the shapes:
-/// `out = Σ_k s_k Ψ_{·,k}`, one register row of points per mode (no horizontal sums).
-struct PointMotion<'a, T: Real> {
-    /// Ψᵀ: `modes × stride` (points padded to whole register pairs).
-    transposed: &'a [T],
-    stride: usize,
-    s: &'a [T],
-    out: &'a mut [T],
-}
-
-impl<T: Real> WithSimd for PointMotion<'_, T> {
-    type Output = ();
-
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
-        let out = T::lanes_mut::<S>(self.out);
-        // The partial sums live in registers when their count is a constant.
-        match out.len() {
-            1 => point_motion_fixed::<T, S, 1>(simd, self.transposed, self.stride, self.s, out),
-            2 => point_motion_fixed::<T, S, 2>(simd, self.transposed, self.stride, self.s, out),
-            3 => point_motion_fixed::<T, S, 3>(simd, self.transposed, self.stride, self.s, out),
-            4 => point_motion_fixed::<T, S, 4>(simd, self.transposed, self.stride, self.s, out),
-            _ => {
-                let zero = T::splat(simd, T::default());
-                out.fill(zero);
-                for (step, row) in self.s.iter().zip(self.transposed.chunks_exact(self.stride)) {
-                    let step = T::splat(simd, *step);
-                    for (sum, shape) in out.iter_mut().zip(T::lanes::<S>(row)) {
-                        *sum = T::mul_add(simd, *shape, step, *sum);
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// [`PointMotion`] for `R` registers of points: four modes at a time into four partial sums, so
-/// that the multiply-add chains are a quarter of the modes long.
-#[inline(always)]
-fn point_motion_fixed<T: Real, S: Simd, const R: usize>(
-    simd: S,
-    transposed: &[T],
-    stride: usize,
-    s: &[T],
-    out: &mut [T::Lanes<S>],
-) {
-    let zero = T::splat(simd, T::default());
-    let mut partial = [[zero; R]; 4];
-    let mut modes = s.chunks_exact(4);
-    let mut rows = transposed.chunks_exact(4 * stride);
-    for (steps, block) in (&mut modes).zip(&mut rows) {
-        for (j, (step, row)) in steps.iter().zip(block.chunks_exact(stride)).enumerate() {
-            let step = T::splat(simd, *step);
-            let row = T::lanes::<S>(&row[..stride]);
-            for r in 0..R {
-                partial[j][r] = T::mul_add(simd, row[r], step, partial[j][r]);
-            }
-        }
-    }
-    for (step, row) in modes
-        .remainder()
-        .iter()
-        .zip(rows.remainder().chunks_exact(stride))
-    {
-        let step = T::splat(simd, *step);
-        let row = T::lanes::<S>(row);
-        for r in 0..R {
-            partial[0][r] = T::mul_add(simd, row[r], step, partial[0][r]);
-        }
-    }
-    for (r, value) in out.iter_mut().enumerate().take(R) {
-        *value = T::add(
-            simd,
-            T::add(simd, partial[0][r], partial[1][r]),
-            T::add(simd, partial[2][r], partial[3][r]),
-        );
     }
 }
 
@@ -398,17 +319,6 @@ impl Kernels {
         self.arch.dispatch(FreeStep { a, b, r, p, s });
     }
 
-    /// `out = Σ_k s_k transposed[k]`: the motion of every point, with the shapes stored
-    /// mode-major (`transposed[k * stride + i] = Ψ_ik`; `out.len() ≤ stride`, whole registers).
-    pub fn point_motion<T: Real>(&self, transposed: &[T], stride: usize, s: &[T], out: &mut [T]) {
-        self.arch.dispatch(PointMotion {
-            transposed,
-            stride,
-            s,
-            out,
-        });
-    }
-
     /// `out[j] = matrix[rows[j]] · x` for every listed row of the row-major `matrix` whose rows
     /// start `stride` elements apart (`x.len() ≤ stride`).
     pub fn dots<T: Real>(
@@ -485,25 +395,12 @@ mod tests {
         for k in 0..n {
             assert!((s[k] - (a[k] * p[k] - b[k] * r[k])).abs() < 1e-15);
         }
-        // The same motions from the mode-major copy.
-        let stride = 32;
-        let mut transposed = vec![0.0; n * stride];
-        for (j, row) in rows.iter().enumerate() {
-            for k in 0..n {
-                transposed[k * stride + j] = row[k];
-            }
-        }
-        let mut motion = vec![0.0; stride];
-        kernels.point_motion(&transposed, stride, &s, &mut motion);
-
         let mut dots = vec![0.0; rows.len()];
         kernels.dots(&matrix, n, &all, &s, &mut dots);
         for (j, row) in rows.iter().enumerate() {
             let plain: f64 = row.iter().zip(&s).map(|(x, y)| x * y).sum();
             assert!((dots[j] - plain).abs() < 1e-13, "row {j}");
-            assert!((motion[j] - plain).abs() < 1e-13, "row {j}");
         }
-        assert!(motion[rows.len()..].iter().all(|&v| v == 0.0));
 
         let forces = [0.3, -1.2, 0.05];
         let (mut s2, mut r2, mut p2) = (s.clone(), r.clone(), p.clone());

@@ -12,6 +12,10 @@
 //!   mode shapes there, with the seed's mid-point Hunt–Crossley force (eq. 4, `contact.rs`).
 //! - `solve.rs`: Newton's method on the points that touch (section 4), the static problems of
 //!   the rest state and the pluck, and the linearised fundamental the tuning uses (section 5).
+//!   Only the points within [`TRACKING_BAND_M`] of contact are followed exactly every step; a
+//!   far point carries an upper bound on its gap, raised each step by the most it can move,
+//!   `‖Ψ_i‖ ‖s_free‖ + |Σ_j G_ij ΔF_j|` (Cauchy–Schwarz), and is evaluated exactly only when that
+//!   bound comes near contact, so the solve stays exact for every point.
 //! - `lanes.rs`: the three passes over the modes as SIMD kernels, dispatched at run time.
 //!
 //! Energy (eq. M3): `H = Σ_k [r_k²/2 + (a_k/2b_k) p_k²] + Σ_i V_i(a_i)` changes over a step by
@@ -49,8 +53,9 @@ const TUNING_ITERATIONS: usize = 30;
 /// Every other point's step follows from the converged forces, and a point that would touch joins
 /// before the step is taken (`ModalString::step`), so the band is only a matter of cost.
 pub const TRACKING_BAND_M: f64 = 20e-6;
-/// The points' motion vector is padded to a multiple of this (one AVX-512 register of f32).
-const POINT_PADDING: usize = 16;
+/// Relative margin on the bound `|Ψ_i · s| ≤ ‖Ψ_i‖ ‖s‖` for the rounding of the kernels' dot
+/// products (f32 over at most 128 terms: well under 1e-4).
+const SHAPE_NORM_MARGIN: f64 = 1e-4;
 
 /// Everything that defines one modal string.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -182,10 +187,11 @@ pub struct ModalString<T: Real> {
     modal_force: Vec<T>,
     /// Ψ rows in T, `points.capacity() × MODE_CAPACITY` (the force projection).
     shapes: Vec<T>,
-    /// Ψ mode-major in T, `MODE_CAPACITY × point_stride` (the points' free motion).
-    transposed_shapes: Vec<T>,
-    point_stride: usize,
-    point_motion: Vec<T>,
+    /// ‖Ψ_i‖₂ over the kept modes, with a margin for the rounding of the T rows: the bound
+    /// `|Ψ_i · s| ≤ ‖Ψ_i‖ ‖s‖` that lets a far point skip its free step.
+    shape_norms: Vec<f64>,
+    /// Free steps of the tracked points, in tracked order.
+    tracked_motion: Vec<f64>,
     points: ContactPoints,
     contact: ContactStep,
     solver: StaticSolver,
@@ -194,6 +200,8 @@ pub struct ModalString<T: Real> {
     rest_modal: Vec<f64>,
     row: Vec<f64>,
     stats: NewtonStats,
+    /// ‖s_free‖₂ of this step, with the rounding margin.
+    step_norm: f64,
     nut_force_change_n: f64,
     bridge_force_change_n: f64,
     rest_nut_force_n: f64,
@@ -209,7 +217,6 @@ impl<T: Real> ModalString<T> {
     /// Builds the string and settles it at rest on bridge and thread. Allocates.
     pub fn new(config: ModalStringConfig) -> Self {
         let points = config.point_capacity();
-        let stride = points.div_ceil(POINT_PADDING) * POINT_PADDING;
         let finger = grid_points(0.0, MAX_FINGER_WIDTH_M, config.finger.spacing_m);
         let mut string = Self {
             config,
@@ -224,9 +231,8 @@ impl<T: Real> ModalString<T> {
             step: vec![T::default(); MODE_CAPACITY],
             modal_force: vec![T::default(); MODE_CAPACITY],
             shapes: vec![T::default(); points * MODE_CAPACITY],
-            transposed_shapes: vec![T::default(); MODE_CAPACITY * stride],
-            point_stride: stride,
-            point_motion: vec![T::default(); stride],
+            shape_norms: vec![0.0; points],
+            tracked_motion: vec![0.0; points],
             points: ContactPoints::with_capacity(points),
             contact: ContactStep::new(points),
             solver: StaticSolver::new(points + finger),
@@ -234,6 +240,7 @@ impl<T: Real> ModalString<T> {
             rest_modal: vec![0.0; MODE_CAPACITY],
             row: vec![0.0; MODE_CAPACITY],
             stats: NewtonStats::default(),
+            step_norm: 0.0,
             nut_force_change_n: 0.0,
             bridge_force_change_n: 0.0,
             rest_nut_force_n: 0.0,
@@ -318,11 +325,15 @@ impl<T: Real> ModalString<T> {
         for (target, source) in self.shapes.iter_mut().zip(&self.points.shapes) {
             *target = T::from_f64(*source);
         }
-        self.transposed_shapes.fill(T::default());
         for i in 0..self.points.len() {
-            for (k, value) in self.points.shape(i).iter().enumerate() {
-                self.transposed_shapes[k * self.point_stride + i] = T::from_f64(*value);
-            }
+            let norm = self
+                .points
+                .shape(i)
+                .iter()
+                .map(|v| v * v)
+                .sum::<f64>()
+                .sqrt();
+            self.shape_norms[i] = norm * (1.0 + SHAPE_NORM_MARGIN);
         }
     }
 
@@ -403,20 +414,31 @@ impl<T: Real> ModalString<T> {
             &mut self.step[..lanes],
         );
         let count = self.points.len();
-        let padded = count.div_ceil(POINT_PADDING) * POINT_PADDING;
-        self.kernels.point_motion(
-            &self.transposed_shapes[..lanes * self.point_stride],
-            self.point_stride,
-            &self.step[..lanes],
-            &mut self.point_motion[..padded],
-        );
+        // The free step of the tracked points exactly; of the others only a bound, ‖Ψ_i‖ ‖s‖.
         let contact = &mut self.contact;
-        for (free, motion) in contact.free_steps_m[..count]
-            .iter_mut()
-            .zip(&self.point_motion)
-        {
-            *free = motion.to_f64();
+        let tracked = contact.tracked_count;
+        self.kernels.dots(
+            &self.shapes,
+            MODE_CAPACITY,
+            &contact.tracked[..tracked],
+            &self.step[..lanes],
+            &mut self.tracked_motion[..tracked],
+        );
+        contact.fresh[..count].fill(false);
+        for (&i, &motion) in contact.tracked[..tracked].iter().zip(&self.tracked_motion) {
+            contact.free_steps_m[i] = motion;
+            contact.fresh[i] = true;
         }
+        let mut norm = [0.0];
+        self.kernels.dots(
+            &self.step[..lanes],
+            lanes,
+            &[0],
+            &self.step[..lanes],
+            &mut norm,
+        );
+        self.step_norm = norm[0].sqrt() * (1.0 + SHAPE_NORM_MARGIN);
+        let contact = &mut self.contact;
         contact.gather(&self.points);
         let mut iterations = 0;
         let mut converged = true;
@@ -451,8 +473,13 @@ impl<T: Real> ModalString<T> {
         }
         let mut penetration = 0.0f64;
         for i in 0..count {
-            contact.gaps_m[i] -= contact.steps_m[i];
-            penetration = penetration.max(contact.gaps_m[i]);
+            if contact.fresh[i] {
+                contact.gaps_m[i] -= contact.steps_m[i];
+                contact.gap_bounds_m[i] = contact.gaps_m[i];
+                penetration = penetration.max(contact.gaps_m[i]);
+            } else {
+                contact.gap_bounds_m[i] += contact.motion_bounds_m[i];
+            }
         }
         if self.config.track_energy {
             // Contact damping at this step's forces; the modes' loss needs the whole step below.
@@ -493,23 +520,32 @@ impl<T: Real> ModalString<T> {
 
     /// The step of every untracked point from the converged forces,
     /// `Δu_i = Δu_free,i + Σ_j G_ij ΔF_j`: a point that would touch during this step joins the
-    /// tracked set now (returns true: the solve must be redone), one that comes within
-    /// [`TRACKING_BAND_M`] of contact joins after the step.
+    /// tracked set now (returns true: the solve must be redone). A point whose gap bound stays
+    /// below zero after the largest step it can take, `‖Ψ_i‖ ‖s_free‖ + |Σ_j G_ij ΔF_j|`, cannot
+    /// touch and is skipped: its gap bound grows by that much instead. Otherwise its gap and free
+    /// step are computed exactly.
     fn check_untracked_points(&mut self) -> bool {
-        let contact = &mut self.contact;
-        let points = &self.points;
         let mut redo = false;
-        for i in 0..points.len() {
-            if contact.is_tracked[i] {
+        for i in 0..self.points.len() {
+            if self.contact.is_tracked[i] {
                 continue;
             }
-            let mut step = contact.free_steps_m[i];
-            for (&j, change) in contact.loaded[..contact.loaded_count]
+            let contact = &self.contact;
+            let coupled: f64 = contact.loaded[..contact.loaded_count]
                 .iter()
                 .zip(&contact.force_changes_n)
-            {
-                step += points.coupling(i, j) * change;
+                .map(|(&j, change)| self.points.coupling(i, j) * change)
+                .sum();
+            if !contact.fresh[i] {
+                let reach = self.shape_norms[i] * self.step_norm + coupled.abs();
+                if contact.gap_bounds_m[i] + reach <= 0.0 {
+                    self.contact.motion_bounds_m[i] = reach;
+                    continue;
+                }
+                self.refresh_point(i);
             }
+            let contact = &mut self.contact;
+            let step = contact.free_steps_m[i] + coupled;
             contact.steps_m[i] = step;
             if contact.gaps_m[i] - step > 0.0 {
                 contact.corrections_m[i] = step - contact.free_steps_m[i];
@@ -520,14 +556,46 @@ impl<T: Real> ModalString<T> {
         redo
     }
 
-    /// After a step: untracked points that came within [`TRACKING_BAND_M`] of contact join the
-    /// tracked set; tracked points farther than twice that, with no force now or at rest, leave it.
-    fn update_tracking(&mut self) {
+    /// `Ψ_i · x` in the kernels' precision, accumulated in f64.
+    fn point_dot(&self, i: usize, x: &[T]) -> f64 {
+        let mut out = [0.0];
+        self.kernels.dots(
+            &self.shapes,
+            MODE_CAPACITY,
+            &[i],
+            &x[..self.lanes],
+            &mut out,
+        );
+        out[0]
+    }
+
+    /// Computes point i's gap `a_rest,i − Ψ_i r̃` and free step `Ψ_i s_free` exactly, before the
+    /// step is taken.
+    fn refresh_point(&mut self, i: usize) {
+        let gap = self.points.rest_gaps_m[i] - self.point_dot(i, &self.modal);
+        let free = self.point_dot(i, &self.step);
         let contact = &mut self.contact;
-        let points = &self.points;
-        contact.release_far(points, 2.0 * TRACKING_BAND_M);
-        for i in 0..points.len() {
-            if !contact.is_tracked[i] && contact.gaps_m[i] > -TRACKING_BAND_M {
+        contact.gaps_m[i] = gap;
+        contact.gap_bounds_m[i] = gap;
+        contact.free_steps_m[i] = free;
+        contact.fresh[i] = true;
+    }
+
+    /// After a step: untracked points whose gap bound comes within [`TRACKING_BAND_M`] of
+    /// contact get their exact gap, and join the tracked set if it is within the band; tracked
+    /// points farther than twice that, with no force now or at rest, leave it.
+    fn update_tracking(&mut self) {
+        self.contact
+            .release_far(&self.points, 2.0 * TRACKING_BAND_M);
+        for i in 0..self.points.len() {
+            if self.contact.is_tracked[i] || self.contact.gap_bounds_m[i] <= -TRACKING_BAND_M {
+                continue;
+            }
+            let gap = self.points.rest_gaps_m[i] - self.point_dot(i, &self.modal);
+            let contact = &mut self.contact;
+            contact.gaps_m[i] = gap;
+            contact.gap_bounds_m[i] = gap;
+            if gap > -TRACKING_BAND_M {
                 contact.corrections_m[i] = 0.0;
                 contact.track(i);
             }
@@ -755,7 +823,14 @@ impl<T: Real> ModalString<T> {
         (&self.modal[..count], &self.velocity[..count])
     }
 
-    /// The gaps a_i of the points now, m (positive: the string penetrates).
+    /// The points Newton iterates on now (those near contact or loaded at rest).
+    pub fn tracked_points(&self) -> usize {
+        self.contact.tracked_count
+    }
+
+    /// The gaps a_i of the points, m (positive: the string penetrates): exact for the points near
+    /// contact, the last computed value for the far ones (whose gaps are only bounded while they
+    /// cannot touch; [`ModalString::displacement_at_m`] gives the exact shape anywhere).
     pub fn gaps_m(&self) -> &[f64] {
         &self.contact.gaps_m[..self.points.len()]
     }

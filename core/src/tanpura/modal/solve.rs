@@ -36,8 +36,15 @@ use crate::tanpura::contact::HuntCrossley;
 /// every point.
 #[derive(Debug, Clone)]
 pub struct ContactStep {
-    /// a_i before the step, m.
+    /// a_i before the step, m: exact for the points whose free step was computed this step
+    /// (`fresh`), the last exact value for the others.
     pub gaps_m: Vec<f64>,
+    /// An upper bound on a_i before the step, m (a_i itself where it is exact).
+    pub gap_bounds_m: Vec<f64>,
+    /// Whether point i's gap and free step are exact this step.
+    pub fresh: Vec<bool>,
+    /// For a point left out this step: a bound on |Δu_i|, m.
+    pub motion_bounds_m: Vec<f64>,
     /// Ψ_i · s_free, m.
     pub free_steps_m: Vec<f64>,
     /// Δu_i, m: the accepted step of every point.
@@ -64,6 +71,9 @@ impl ContactStep {
         let zeros = || vec![0.0; capacity];
         Self {
             gaps_m: zeros(),
+            gap_bounds_m: zeros(),
+            fresh: vec![false; capacity],
+            motion_bounds_m: zeros(),
             free_steps_m: zeros(),
             steps_m: zeros(),
             corrections_m: zeros(),
@@ -115,11 +125,13 @@ impl ContactStep {
     }
 
     /// Tracks the points whose gap lies within `band_m` of contact or that carry a force at rest.
+    /// Every gap must be exact on entry.
     pub fn classify(&mut self, points: &ContactPoints, band_m: f64) {
         self.tracked_count = 0;
         self.block_stale = true;
         for i in 0..points.len() {
             self.is_tracked[i] = false;
+            self.gap_bounds_m[i] = self.gaps_m[i];
             if self.gaps_m[i] > -band_m || points.rest_forces_n[i] != 0.0 {
                 self.track(i);
             }
@@ -189,6 +201,8 @@ pub struct TrackedSolve {
     /// G on the tracked points, `count × count`.
     coupling: Vec<f64>,
     residual: Vec<f64>,
+    /// The points with c > 0 at the last evaluation (local indices) and their √c.
+    active: Vec<usize>,
     roots: Vec<f64>,
     matrix: Vec<f64>,
     solution: Vec<f64>,
@@ -233,36 +247,35 @@ fn ldl_solve_in_place(matrix: &mut [f64], n: usize, x: &mut [f64], scratch: &mut
     }
 }
 
-/// Tracked points up to which the Newton update runs on fixed-size arrays.
-const SMALL: usize = 8;
-
-/// [`ldl_solve_in_place`] on a fixed-size matrix (lower triangle used).
-fn ldl_solve_small(matrix: &mut [[f64; SMALL]; SMALL], x: &mut [f64; SMALL]) {
-    let mut weighted = [0.0; SMALL];
-    for j in 0..SMALL {
+/// [`ldl_solve_in_place`] on a fixed-size matrix (lower triangle used), for contact sets of up to
+/// `N` points padded with identity rows; the compiler unrolls it.
+fn ldl_solve_fixed<const N: usize>(matrix: &mut [[f64; N]; N], x: &mut [f64; N]) {
+    let mut weighted = [0.0; N];
+    for j in 0..N {
         let mut diagonal = matrix[j][j];
         for k in 0..j {
             weighted[k] = matrix[j][k] * matrix[k][k];
             diagonal -= matrix[j][k] * weighted[k];
         }
         matrix[j][j] = diagonal;
-        for i in j + 1..SMALL {
+        let inverse = 1.0 / diagonal;
+        for i in j + 1..N {
             let mut value = matrix[i][j];
             for k in 0..j {
                 value -= matrix[i][k] * weighted[k];
             }
-            matrix[i][j] = value / diagonal;
+            matrix[i][j] = value * inverse;
         }
     }
-    for i in 0..SMALL {
+    for i in 0..N {
         for k in 0..i {
             x[i] -= matrix[i][k] * x[k];
         }
     }
-    for i in 0..SMALL {
+    for i in 0..N {
         x[i] /= matrix[i][i];
     }
-    for i in (0..SMALL).rev() {
+    for i in (0..N).rev() {
         for k in 0..i {
             x[k] -= matrix[i][k] * x[i];
         }
@@ -293,6 +306,7 @@ impl TrackedSolve {
             loaded_count: 0,
             coupling: vec![0.0; capacity * capacity],
             residual: zeros(),
+            active: vec![0; capacity],
             roots: zeros(),
             matrix: vec![0.0; capacity * capacity],
             solution: zeros(),
@@ -374,102 +388,93 @@ impl TrackedSolve {
     }
 
     /// One Newton update `δ = −J⁻¹ R` at the last evaluation; applies it and returns its largest
-    /// component (NaN when the state is not finite). Up to [`SMALL`] tracked points the update
-    /// runs on fixed-size arrays (padded with inert rows), which the compiler unrolls; the same
-    /// algorithm on the heap buffers serves larger contact sets.
+    /// component (NaN when the state is not finite). The residual needs G only on the loaded
+    /// points' columns, the linear solve only on the points with `c > 0` (the others' rows of
+    /// `I + D G D` are identity rows): contact sets up to 4 and 8 points run on fixed-size arrays,
+    /// larger ones on the heap buffers.
     fn update(&mut self) -> f64 {
-        if self.count <= SMALL {
-            self.update_small()
-        } else {
-            self.update_any()
-        }
-    }
-
-    fn update_small(&mut self) -> f64 {
         let count = self.count;
-        let mut coupling = [[0.0; SMALL]; SMALL];
-        let mut changes = [0.0; SMALL];
-        let mut roots = [0.0; SMALL];
-        let mut residual = [0.0; SMALL];
+        // R = Δu − Δu_free − G ΔF, with ΔF ≠ 0 only on the loaded points.
         for t in 0..count {
-            coupling[t][..count].copy_from_slice(&self.coupling[t * count..(t + 1) * count]);
-            changes[t] = self.changes[t];
-            roots[t] = self.stiffnesses[t].sqrt();
-        }
-        // R = Δu − Δu_free − G ΔF (zero on the padding rows).
-        for t in 0..count {
-            let coupled: f64 = (0..SMALL).map(|u| coupling[t][u] * changes[u]).sum();
-            residual[t] = self.steps[t] - self.free_steps[t] - coupled;
-        }
-        // (I + D G D) y = −D R, lower triangle; the padding rows are identity rows with y = 0.
-        let mut matrix = [[0.0; SMALL]; SMALL];
-        let mut y = [0.0; SMALL];
-        for t in 0..SMALL {
-            for u in 0..SMALL {
-                matrix[t][u] = roots[t] * coupling[t][u] * roots[u];
-            }
-            matrix[t][t] += 1.0;
-            y[t] = -roots[t] * residual[t];
-        }
-        ldl_solve_small(&mut matrix, &mut y);
-        for t in 0..SMALL {
-            y[t] *= roots[t];
-        }
-        // δ = −R − G D y.
-        let mut largest = 0.0f64;
-        for t in 0..count {
-            let coupled: f64 = (0..SMALL).map(|u| coupling[t][u] * y[u]).sum();
-            let delta = -residual[t] - coupled;
-            self.steps[t] += delta;
-            largest = largest.max(delta.abs());
-        }
-        if y.iter().all(|v| v.is_finite()) {
-            largest
-        } else {
-            f64::NAN
-        }
-    }
-
-    fn update_any(&mut self) -> f64 {
-        let count = self.count;
-        let coupling = &self.coupling[..count * count];
-        let changes = &self.changes[..count];
-        // R = Δu − Δu_free − G ΔF; D = diag(√c).
-        for (t, row) in coupling.chunks_exact(count).enumerate() {
-            let coupled: f64 = row.iter().zip(changes).map(|(g, f)| g * f).sum();
+            let row = &self.coupling[t * count..(t + 1) * count];
+            let coupled: f64 = self.loaded[..self.loaded_count]
+                .iter()
+                .map(|&u| row[u] * self.changes[u])
+                .sum();
             self.residual[t] = self.steps[t] - self.free_steps[t] - coupled;
-            self.roots[t] = self.stiffnesses[t].sqrt();
         }
-        let roots = &self.roots[..count];
-        // (I + D G D) y = −D R over every tracked point: a point without a Jacobian entry has
-        // D = 0, an identity row, and y = 0. The matrix is SPD with eigenvalues ≥ 1, so LDLᵀ
-        // without pivoting is exact and stable; it is a handful of rows, factorised in place.
-        let matrix = &mut self.matrix[..count * count];
-        for (t, row) in coupling.chunks_exact(count).enumerate() {
-            let root = roots[t];
-            for u in 0..=t {
-                matrix[t * count + u] = root * row[u] * roots[u];
+        // A: the points with c > 0, and D = diag(√c) on them.
+        let mut size = 0;
+        for t in 0..count {
+            if self.stiffnesses[t] > 0.0 {
+                self.active[size] = t;
+                self.roots[size] = self.stiffnesses[t].sqrt();
+                size += 1;
             }
-            matrix[t * count + t] += 1.0;
-            self.solution[t] = -root * self.residual[t];
         }
-        let solution = &mut self.solution[..count];
-        ldl_solve_in_place(matrix, count, solution, &mut self.scratch[..count]);
-        for (y, root) in solution.iter_mut().zip(roots) {
-            *y *= root;
+        match size {
+            0 => {}
+            1..=4 => self.solve_active_fixed::<4>(size),
+            5..=8 => self.solve_active_fixed::<8>(size),
+            _ => self.solve_active_any(size),
         }
-        // δ = −R − G D y.
+        // δ = −R − G_{:,A} D y.
         let mut largest = 0.0f64;
-        for (t, row) in coupling.chunks_exact(count).enumerate() {
-            let coupled: f64 = row.iter().zip(&*solution).map(|(g, y)| g * y).sum();
+        for t in 0..count {
+            let row = &self.coupling[t * count..(t + 1) * count];
+            let coupled: f64 = (0..size)
+                .map(|a| row[self.active[a]] * self.solution[a])
+                .sum();
             let delta = -self.residual[t] - coupled;
             self.steps[t] += delta;
             largest = largest.max(delta.abs());
         }
-        if solution.iter().all(|y| y.is_finite()) {
+        if self.solution[..size].iter().all(|y| y.is_finite()) {
             largest
         } else {
             f64::NAN
+        }
+    }
+
+    /// `(I + D G_AA D) y = −D R_A`, then `y ← D y`, into `solution[..size]`, on `N × N` arrays
+    /// padded with identity rows.
+    fn solve_active_fixed<const N: usize>(&mut self, size: usize) {
+        let count = self.count;
+        let mut matrix = [[0.0; N]; N];
+        let mut y = [0.0; N];
+        for a in 0..N {
+            matrix[a][a] = 1.0;
+        }
+        for a in 0..size {
+            let row = &self.coupling[self.active[a] * count..(self.active[a] + 1) * count];
+            for b in 0..=a {
+                matrix[a][b] += self.roots[a] * row[self.active[b]] * self.roots[b];
+            }
+            y[a] = -self.roots[a] * self.residual[self.active[a]];
+        }
+        ldl_solve_fixed(&mut matrix, &mut y);
+        for a in 0..size {
+            self.solution[a] = y[a] * self.roots[a];
+        }
+    }
+
+    /// [`TrackedSolve::solve_active_fixed`] for any size, in the heap buffers. The matrix is SPD
+    /// with eigenvalues ≥ 1, so LDLᵀ without pivoting is exact and stable.
+    fn solve_active_any(&mut self, size: usize) {
+        let count = self.count;
+        let matrix = &mut self.matrix[..size * size];
+        for a in 0..size {
+            let row = &self.coupling[self.active[a] * count..(self.active[a] + 1) * count];
+            for b in 0..=a {
+                matrix[a * size + b] = self.roots[a] * row[self.active[b]] * self.roots[b];
+            }
+            matrix[a * size + a] += 1.0;
+            self.solution[a] = -self.roots[a] * self.residual[self.active[a]];
+        }
+        let solution = &mut self.solution[..size];
+        ldl_solve_in_place(matrix, size, solution, &mut self.scratch[..size]);
+        for (y, root) in solution.iter_mut().zip(&self.roots[..size]) {
+            *y *= root;
         }
     }
 
@@ -806,7 +811,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_small_ldl_agrees_with_the_general_one() {
+    fn the_fixed_size_ldl_agrees_with_the_general_one() {
+        const SMALL: usize = 8;
         let n = 5;
         let mut general = vec![0.0; n * n];
         let mut small = [[0.0; SMALL]; SMALL];
@@ -829,7 +835,7 @@ mod tests {
         let mut y = [0.0; SMALL];
         y[..n].copy_from_slice(&rhs);
         ldl_solve_in_place(&mut general, n, &mut x, &mut [0.0; 5]);
-        ldl_solve_small(&mut small, &mut y);
+        ldl_solve_fixed(&mut small, &mut y);
         for i in 0..n {
             assert!((x[i] - y[i]).abs() < 1e-14);
         }
