@@ -1,21 +1,13 @@
 //! `cargo xtask render`: MIDI file (or the built-in demo scene) to a WAV file, through the same
 //! engine the plugin runs (`javari_core::engine::render`).
 //!
-//! Options:
-//!   --midi FILE          standard MIDI file; without it the built-in demo scene is rendered
-//!   --preset FILE        preset file (presets/*.toml); default: the classic settings
-//!   --out FILE.wav       default out/demo.wav, or out/<midi name>.wav
-//!   --sample-rate HZ     8000–192000, default 44100
-//!   --block-size N       1–65536 samples per process call, default 512
-//!   --quality TIER       draft | live | studio | reference, or preset (default: the preset's
-//!                        own, else reference)
-//!   --tail-seconds S     0–60 s rendered after the last event, default 3
-//!   --plot FILE.png      spectrogram of the result
-//!
-//! The WAV file is mono, 32-bit float at full scale ±1. A progress bar goes to stderr.
+//! Options: `cargo xtask render --help`. The WAV file is mono, 32-bit float at full scale ±1. A
+//! progress bar goes to stderr.
 
-use crate::args::Args;
+use crate::args::number_in;
 use crate::plot::heatmap;
+use clap::builder::PossibleValuesParser;
+use clap::Parser;
 use javari_core::analysis::power_spectrum;
 use javari_core::engine::bowed_stability::bowed_stability;
 use javari_core::engine::midi_file;
@@ -30,21 +22,48 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
-    let mut args = Args::parse(raw, &[])?;
-    let midi = args.text("midi").map(PathBuf::from);
-    let preset_path = args.text("preset").map(PathBuf::from);
-    let out = args.text("out").map(PathBuf::from);
-    let sample_rate_hz: f64 = args.number("sample-rate", 44_100.0, 8_000.0, 192_000.0)?;
-    let block_size: usize = args.number("block-size", 512, 1, 65_536)?;
-    // "preset" keeps the preset's own quality.
-    let mut quality_choices = QUALITY_NAMES.to_vec();
-    quality_choices.push("preset");
-    let quality = args.choice("quality", "preset", &quality_choices)?;
-    let quality = Quality::from_name(quality);
-    let tail_s: f64 = args.number("tail-seconds", 3.0, 0.0, 60.0)?;
-    let plot = args.text("plot").map(PathBuf::from);
-    args.finish()?;
+#[derive(Debug, Parser)]
+pub struct RenderArgs {
+    /// Standard MIDI file; without it the built-in demo scene is rendered.
+    #[arg(long, value_name = "FILE")]
+    midi: Option<PathBuf>,
+    /// Preset file (presets/*.toml); default: the classic settings.
+    #[arg(long, value_name = "FILE")]
+    preset: Option<PathBuf>,
+    /// Output WAV file; default out/demo.wav, or out/<midi name>.wav.
+    #[arg(long, value_name = "FILE.wav")]
+    out: Option<PathBuf>,
+    /// Output sample rate, Hz (8000 to 192000).
+    #[arg(long, value_name = "HZ", default_value_t = 44_100.0,
+          value_parser = number_in(8_000.0, 192_000.0))]
+    sample_rate: f64,
+    /// Samples per process call, as a host's buffer size (1 to 65536).
+    #[arg(long, value_name = "N", default_value_t = 512, value_parser = number_in(1usize, 65_536))]
+    block_size: usize,
+    /// Quality tier; `preset` keeps the preset's own (reference without a preset).
+    #[arg(long, value_name = "TIER", default_value = "preset",
+          value_parser = PossibleValuesParser::new(QUALITY_NAMES.into_iter().chain(["preset"])))]
+    quality: String,
+    /// Seconds rendered after the last event (0 to 60).
+    #[arg(long, value_name = "S", default_value_t = 3.0, value_parser = number_in(0.0, 60.0))]
+    tail_seconds: f64,
+    /// Also write a spectrogram of the result as a PNG.
+    #[arg(long, value_name = "FILE.png")]
+    plot: Option<PathBuf>,
+}
+
+pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let RenderArgs {
+        midi,
+        preset: preset_path,
+        out,
+        sample_rate: sample_rate_hz,
+        block_size,
+        quality,
+        tail_seconds: tail_s,
+        plot,
+    } = args;
+    let quality = Quality::from_name(&quality);
 
     let (score, default_out) = match &midi {
         Some(path) => {
