@@ -8,6 +8,7 @@ use crate::args::number_in;
 use crate::plot::heatmap;
 use clap::builder::PossibleValuesParser;
 use clap::Parser;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use javari_core::analysis::power_spectrum;
 use javari_core::engine::bowed_stability::bowed_stability;
 use javari_core::engine::midi_file;
@@ -18,7 +19,7 @@ use javari_core::engine::render::{render, rendered_length, RenderOptions, Score}
 use javari_core::engine::wav::write_wav;
 use javari_core::engine::{EngineEvent, EngineSettings, Instrument};
 use javari_core::tanpura::quality::Quality;
-use std::io::Write;
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -106,11 +107,11 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         out.display()
     );
     let started = Instant::now();
-    let mut bar = ProgressBar::new();
-    let signal = render(&settings, &score, &options, &mut |done, total| {
-        bar.update(done, total)
+    let bar = progress_bar(total);
+    let signal = render(&settings, &score, &options, &mut |done, _| {
+        bar.set_position(done as u64)
     });
-    bar.finish();
+    bar.finish_and_clear();
     let elapsed_s = started.elapsed().as_secs_f64();
     write_wav(&out, &signal, sample_rate_hz)?;
     let peak = signal.iter().fold(0.0f32, |peak, x| peak.max(x.abs()));
@@ -214,44 +215,17 @@ fn warn_if_bowed_preset_is_unstable(settings: &EngineSettings, score: &Score) {
     }
 }
 
-/// A one-line progress bar on stderr, redrawn when the percentage changes.
-struct ProgressBar {
-    last_percent: Option<usize>,
-    started: Instant,
-}
-
-impl ProgressBar {
-    const WIDTH: usize = 40;
-
-    fn new() -> Self {
-        Self {
-            last_percent: None,
-            started: Instant::now(),
-        }
+/// The render's progress bar on stderr (indicatif), hidden when stderr is not a terminal (a log
+/// file or CI gets the summary lines only).
+fn progress_bar(total: usize) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
     }
-
-    fn update(&mut self, done: usize, total: usize) {
-        let percent = (done * 100).checked_div(total).unwrap_or(100);
-        if self.last_percent == Some(percent) {
-            return;
-        }
-        self.last_percent = Some(percent);
-        let filled = percent * Self::WIDTH / 100;
-        let elapsed = self.started.elapsed().as_secs_f64();
-        let remaining = if done > 0 {
-            elapsed * (total - done) as f64 / done as f64
-        } else {
-            0.0
-        };
-        eprint!(
-            "\r[{}{}] {percent:3}%  {remaining:5.1} s left",
-            "#".repeat(filled),
-            " ".repeat(Self::WIDTH - filled)
-        );
-        let _ = std::io::stderr().flush();
-    }
-
-    fn finish(&self) {
-        eprintln!();
-    }
+    let bar = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("[{bar:40}] {percent:>3}%  {eta} left")
+            .expect("a valid template")
+            .progress_chars("#> "),
+    );
+    bar
 }
