@@ -15,10 +15,11 @@ use javari_core::engine::midi_file;
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::preset::{Preset, QUALITY_NAMES};
 use javari_core::engine::render::ScoreAction;
-use javari_core::engine::render::{render, rendered_length, RenderOptions, Score};
+use javari_core::engine::render::{render, render_with, rendered_length, RenderOptions, Score};
 use javari_core::engine::wav::write_wav;
-use javari_core::engine::{EngineEvent, EngineSettings, Instrument};
+use javari_core::engine::{EngineEvent, EngineSettings, Instrument, VoiceTask};
 use javari_core::tanpura::quality::Quality;
+use rayon::prelude::*;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -51,6 +52,10 @@ pub struct RenderArgs {
     /// Also write a spectrogram of the result as a PNG.
     #[arg(long, value_name = "FILE.png")]
     plot: Option<PathBuf>,
+    /// Threads that run the voices (1 to 256; default: every core). The output is bit-identical
+    /// for any number.
+    #[arg(long, value_name = "N", value_parser = number_in(1usize, 256))]
+    jobs: Option<usize>,
 }
 
 pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
@@ -63,7 +68,9 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         quality,
         tail_seconds: tail_s,
         plot,
+        jobs,
     } = args;
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
     let quality = Quality::from_name(&quality);
 
     let (score, default_out) = match &midi {
@@ -96,7 +103,7 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
 
     let total = rendered_length(&score, &options);
     eprintln!(
-        "rendering {} ({:.1} s at {} Hz, {} quality) to {}",
+        "rendering {} ({:.1} s at {} Hz, {} quality, {jobs} thread{}) to {}",
         midi.as_deref()
             .map_or("the demo scene".to_string(), |path| path
                 .display()
@@ -104,13 +111,14 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         total as f64 / sample_rate_hz,
         sample_rate_hz,
         settings.voice.quality.name(),
+        if jobs == 1 { "" } else { "s" },
         out.display()
     );
     let started = Instant::now();
     let bar = progress_bar(total);
-    let signal = render(&settings, &score, &options, &mut |done, _| {
+    let signal = render_on(jobs, &settings, &score, &options, &mut |done, _| {
         bar.set_position(done as u64)
-    });
+    })?;
     bar.finish_and_clear();
     let elapsed_s = started.elapsed().as_secs_f64();
     write_wav(&out, &signal, sample_rate_hz)?;
@@ -128,6 +136,28 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         eprintln!("wrote the spectrogram {}", plot.display());
     }
     Ok(())
+}
+
+/// [`render`] with the voices of each segment on `jobs` threads (rayon); one job renders on this
+/// thread exactly as the plugin does. The voices' outputs are summed in a fixed order
+/// ([`javari_core::engine::Engine::process_with`]), so the signal does not depend on `jobs`.
+fn render_on(
+    jobs: usize,
+    settings: &EngineSettings,
+    score: &Score,
+    options: &RenderOptions,
+    progress: &mut (dyn FnMut(usize, usize) + Send),
+) -> Result<Vec<f32>, rayon::ThreadPoolBuildError> {
+    if jobs <= 1 {
+        return Ok(render(settings, score, options, progress));
+    }
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
+    // The whole render runs inside the pool, so that handing out a segment's voices is a cheap
+    // fork-join among its threads.
+    Ok(pool.install(|| {
+        let runner = |tasks: &mut [VoiceTask<'_>]| tasks.par_iter_mut().for_each(VoiceTask::run);
+        render_with(settings, score, options, &runner, progress)
+    }))
 }
 
 /// Frame length and hop of the spectrogram, samples.
@@ -228,4 +258,34 @@ fn progress_bar(total: usize) -> ProgressBar {
             .progress_chars("#> "),
     );
     bar
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_number_of_jobs_renders_the_same_bits() {
+        // Overlapping notes on several strings, so that several voices share each segment.
+        let mut score = Score::default();
+        for (index, note) in [43u8, 48, 52, 55, 36, 60].into_iter().enumerate() {
+            score.note(0.02 * index as f64, 0.2, note, 0.9);
+        }
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = Quality::Draft;
+        let options = RenderOptions {
+            tail_s: 0.1,
+            block_size: 256,
+            ..RenderOptions::default()
+        };
+        let bits = |jobs| {
+            let signal = render_on(jobs, &settings, &score, &options, &mut |_, _| {}).unwrap();
+            signal.iter().map(|x| x.to_bits()).collect::<Vec<u32>>()
+        };
+        let one = bits(1);
+        assert!(one.iter().any(|&x| f32::from_bits(x) != 0.0));
+        for jobs in [2, 3, 8] {
+            assert!(one == bits(jobs), "{jobs} jobs differ from one");
+        }
+    }
 }
