@@ -30,6 +30,7 @@ use javari_core::stability::{
     ReflectionFunction, SpaceTimeModel, StabilityMargin, ThresholdOutcome, ThresholdSearch,
     TransferModel,
 };
+use rayon::prelude::*;
 use std::error::Error;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -470,60 +471,66 @@ struct SweepRow {
 
 fn sweep_rows(figure: Figure) -> Result<Vec<SweepRow>, Box<dyn Error>> {
     let search = ThresholdSearch::default();
-    let mut rows = Vec::new();
-    let mut push = |p, q, slip_steps, formulation, outcome: ThresholdOutcome| {
-        let threshold = outcome.crossing();
-        rows.push(SweepRow {
-            p,
-            q,
-            slip_steps,
-            formulation,
-            zeta_c: threshold.map_or(f64::NAN, |threshold| threshold.zeta),
-            order: threshold.map(|threshold| threshold.critical.subharmonic_order),
-        });
+    // (p, q, slipping steps) of every case of the figure.
+    let cases: Vec<(usize, usize, usize)> = match figure {
+        Figure::Fig7 | Figure::Fig8 | Figure::Fig13 => (1..=10)
+            .flat_map(|p| (p..=20).map(move |q| (p, q, p)))
+            .collect(),
+        Figure::Fig10 => [(3, 16), (4, 15), (5, 14), (6, 13), (7, 12)]
+            .into_iter()
+            .flat_map(|(p, q)| (1..=30).map(move |slip| (p, q, slip)))
+            .collect(),
     };
-    match figure {
+    // The cases are independent: rayon spreads them over the cores; `collect` keeps their order.
+    let rows: Result<Vec<SweepRow>, String> = cases
+        .par_iter()
+        .map(|&(p, q, slip)| {
+            sweep_case(&search, figure, p, q, slip)
+                .map_err(|error| format!("p = {p}, q = {q}, slip = {slip}: {error}"))
+        })
+        .collect();
+    Ok(rows?)
+}
+
+/// One case of a sweep: its threshold by the formulation the figure uses.
+fn sweep_case(
+    search: &ThresholdSearch,
+    figure: Figure,
+    p: usize,
+    q: usize,
+    slip_steps: usize,
+) -> Result<SweepRow, Box<dyn Error>> {
+    let (formulation, outcome) = match figure {
         Figure::Fig7 | Figure::Fig13 => {
             let gamma = if figure == Figure::Fig7 { 1.0 } else { 0.9 };
-            for p in 1..=10 {
-                for q in p..=20 {
-                    // The compact formulation: the same spectrum as eq. 15, half the size.
-                    let motion = PeriodicMotion::new(
-                        CompactModel::raman(p, q, SWEEP_LAMBDA)?,
-                        ContactPattern::helmholtz_compact(p, q)?,
-                        gamma,
-                    )?;
-                    push(p, q, p, Formulation::Compact, search.run(&motion)?);
-                }
-            }
+            // The compact formulation: the same spectrum as eq. 15, half the size.
+            let motion = PeriodicMotion::new(
+                CompactModel::raman(p, q, SWEEP_LAMBDA)?,
+                ContactPattern::helmholtz_compact(p, q)?,
+                gamma,
+            )?;
+            (Formulation::Compact, search.run(&motion)?)
         }
-        Figure::Fig8 => {
-            for p in 1..=10 {
-                for q in p..=20 {
-                    // Eq. 16: M₁^p M₂^{2q+p}, an odd slip count needs the space-time form.
-                    let motion = PeriodicMotion::new(
-                        SpaceTimeModel::new(p, q, SWEEP_LAMBDA)?,
-                        ContactPattern::single_slip(2 * (p + q), p)?,
-                        1.0,
-                    )?;
-                    push(p, q, p, Formulation::SpaceTime, search.run(&motion)?);
-                }
-            }
+        // Fig. 8 — eq. 16: M₁^p M₂^{2q+p}, an odd slip count needs the space-time form — and
+        // Fig. 10, the slip time swept.
+        Figure::Fig8 | Figure::Fig10 => {
+            let motion = PeriodicMotion::new(
+                SpaceTimeModel::new(p, q, SWEEP_LAMBDA)?,
+                ContactPattern::single_slip(2 * (p + q), slip_steps)?,
+                1.0,
+            )?;
+            (Formulation::SpaceTime, search.run(&motion)?)
         }
-        Figure::Fig10 => {
-            for (p, q) in [(3, 16), (4, 15), (5, 14), (6, 13), (7, 12)] {
-                for slip in 1..=30 {
-                    let motion = PeriodicMotion::new(
-                        SpaceTimeModel::new(p, q, SWEEP_LAMBDA)?,
-                        ContactPattern::single_slip(2 * (p + q), slip)?,
-                        1.0,
-                    )?;
-                    push(p, q, slip, Formulation::SpaceTime, search.run(&motion)?);
-                }
-            }
-        }
-    }
-    Ok(rows)
+    };
+    let threshold = outcome.crossing();
+    Ok(SweepRow {
+        p,
+        q,
+        slip_steps,
+        formulation,
+        zeta_c: threshold.map_or(f64::NAN, |threshold| threshold.zeta),
+        order: threshold.map(|threshold| threshold.critical.subharmonic_order),
+    })
 }
 
 fn sweep_csv(rows: &[SweepRow]) -> String {
