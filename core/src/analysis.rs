@@ -1,45 +1,41 @@
 //! Signal analysis for tests, benchmarks and the offline tools: FFT, windowed spectra, precise
-//! partial frequencies, spectral centroids and band energies. Not used on the audio thread.
+//! partial frequencies, spectral centroids and band energies. Not used on the audio thread
+//! (the editor's spectrum calls [`fft`] on the GUI thread).
+//!
+//! The transforms are rustfft's (complex) and realfft's (real input), planned once per length and
+//! thread and reused: these tools call them thousands of times with a handful of lengths.
 
+use realfft::num_complex::Complex;
+use realfft::RealFftPlanner;
+use rustfft::FftPlanner;
+use std::cell::RefCell;
 use std::f64::consts::PI;
 
-/// In-place radix-2 complex FFT (`re.len()` must be a power of two).
+thread_local! {
+    /// Plans by length (the planners cache them), one set per thread: the editor's GUI thread
+    /// and each render or analysis worker plan their own.
+    static COMPLEX_PLANNER: RefCell<FftPlanner<f64>> = RefCell::new(FftPlanner::new());
+    static REAL_PLANNER: RefCell<RealFftPlanner<f64>> = RefCell::new(RealFftPlanner::new());
+}
+
+/// In-place forward complex DFT, unnormalised: X[k] = Σ x[j] e^{−2πi jk/n} (any length; powers of
+/// two are the fastest). Allocates a buffer per call: not for the audio thread.
 pub fn fft(re: &mut [f64], im: &mut [f64]) {
     let n = re.len();
-    assert!(
-        n.is_power_of_two() && im.len() == n,
-        "FFT length must be a power of two"
-    );
-    let mut j = 0;
-    for i in 1..n {
-        let mut bit = n >> 1;
-        while j & bit != 0 {
-            j ^= bit;
-            bit >>= 1;
-        }
-        j |= bit;
-        if i < j {
-            re.swap(i, j);
-            im.swap(i, j);
-        }
+    assert_eq!(im.len(), n, "FFT real and imaginary parts differ in length");
+    if n == 0 {
+        return;
     }
-    let mut length = 2;
-    while length <= n {
-        let angle = -2.0 * PI / length as f64;
-        for start in (0..n).step_by(length) {
-            for k in 0..length / 2 {
-                let (sin, cos) = (angle * k as f64).sin_cos();
-                let a = start + k;
-                let b = a + length / 2;
-                let tr = re[b] * cos - im[b] * sin;
-                let ti = re[b] * sin + im[b] * cos;
-                re[b] = re[a] - tr;
-                im[b] = im[a] - ti;
-                re[a] += tr;
-                im[a] += ti;
-            }
-        }
-        length <<= 1;
+    let plan = COMPLEX_PLANNER.with(|planner| planner.borrow_mut().plan_fft_forward(n));
+    let mut buffer: Vec<Complex<f64>> = re
+        .iter()
+        .zip(im.iter())
+        .map(|(&re, &im)| Complex::new(re, im))
+        .collect();
+    plan.process(&mut buffer);
+    for ((re, im), value) in re.iter_mut().zip(im.iter_mut()).zip(buffer) {
+        *re = value.re;
+        *im = value.im;
     }
 }
 
@@ -50,19 +46,21 @@ pub fn hann(n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Power spectrum (|X|², bins 0..=n/2) of `signal[start..start + n]` with a Hann window,
-/// zero-padded to `fft_size` (a power of two ≥ n).
+/// Power spectrum (|X|², bins 0..=fft_size/2) of `signal[start..start + n]` with a Hann window,
+/// zero-padded to `fft_size` (≥ n; a power of two is the fastest). Samples past the end of
+/// `signal` count as zeros.
 pub fn power_spectrum(signal: &[f64], start: usize, n: usize, fft_size: usize) -> Vec<f64> {
+    assert!(n <= fft_size, "the FFT size must hold the windowed frame");
     let window = hann(n);
-    let mut re = vec![0.0; fft_size];
-    let mut im = vec![0.0; fft_size];
-    for i in 0..n {
-        re[i] = signal.get(start + i).copied().unwrap_or(0.0) * window[i];
+    let plan = REAL_PLANNER.with(|planner| planner.borrow_mut().plan_fft_forward(fft_size));
+    let mut frame = plan.make_input_vec();
+    for (i, (sample, weight)) in frame.iter_mut().zip(&window).enumerate() {
+        *sample = signal.get(start + i).copied().unwrap_or(0.0) * weight;
     }
-    fft(&mut re, &mut im);
-    (0..=fft_size / 2)
-        .map(|k| re[k] * re[k] + im[k] * im[k])
-        .collect()
+    let mut spectrum = plan.make_output_vec();
+    plan.process(&mut frame, &mut spectrum)
+        .expect("buffers come from the plan itself");
+    spectrum.iter().map(|bin| bin.norm_sqr()).collect()
 }
 
 /// |Σ x[i] w[i] e^{−2πi f i / fs}|² for one frequency (Hann-windowed DFT at any frequency).
@@ -175,6 +173,23 @@ pub fn band_power(spectrum: &[f64], bin_hz: f64, low_hz: f64, high_hz: f64) -> f
 mod tests {
     use super::*;
 
+    /// X[k] = Σ x[j] e^{−2πi jk/n}, summed term by term.
+    fn direct_dft(re: &[f64], im: &[f64]) -> Vec<(f64, f64)> {
+        let n = re.len();
+        (0..n)
+            .map(|k| {
+                (0..n).fold((0.0, 0.0), |(sum_re, sum_im), j| {
+                    let angle = -2.0 * PI * (j * k) as f64 / n as f64;
+                    let (sin, cos) = angle.sin_cos();
+                    (
+                        sum_re + re[j] * cos - im[j] * sin,
+                        sum_im + re[j] * sin + im[j] * cos,
+                    )
+                })
+            })
+            .collect()
+    }
+
     #[test]
     fn fft_of_a_bin_centred_sine_has_one_peak() {
         let n = 64;
@@ -189,6 +204,45 @@ mod tests {
             .map(|k| re[k].abs() + im[k].abs())
             .sum();
         assert!(others < 1e-9);
+    }
+
+    #[test]
+    fn fft_equals_the_direct_dft() {
+        for n in [1, 8, 12, 16] {
+            let re: Vec<f64> = (0..n).map(|i| (0.7 * i as f64).sin() + 0.1).collect();
+            let im: Vec<f64> = (0..n).map(|i| (1.3 * i as f64).cos() - 0.2).collect();
+            let expected = direct_dft(&re, &im);
+            let (mut out_re, mut out_im) = (re.clone(), im.clone());
+            fft(&mut out_re, &mut out_im);
+            for k in 0..n {
+                assert!((out_re[k] - expected[k].0).abs() < 1e-12, "n {n}, bin {k}");
+                assert!((out_im[k] - expected[k].1).abs() < 1e-12, "n {n}, bin {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn power_spectrum_is_the_hann_windowed_zero_padded_dft() {
+        // A frame that starts inside the signal and runs past its end (zeros), padded 24 → 32.
+        let signal: Vec<f64> = (0..40)
+            .map(|i| (0.37 * i as f64).sin() * 0.8 + 0.05)
+            .collect();
+        let (start, n, fft_size) = (20, 24, 32);
+        let window = hann(n);
+        let mut re = vec![0.0; fft_size];
+        for i in 0..n {
+            re[i] = signal.get(start + i).copied().unwrap_or(0.0) * window[i];
+        }
+        let expected = direct_dft(&re, &vec![0.0; fft_size]);
+        let spectrum = power_spectrum(&signal, start, n, fft_size);
+        assert_eq!(spectrum.len(), fft_size / 2 + 1);
+        for (k, power) in spectrum.iter().enumerate() {
+            let want = expected[k].0 * expected[k].0 + expected[k].1 * expected[k].1;
+            assert!((power - want).abs() < 1e-12 * want.max(1.0), "bin {k}");
+        }
+        // The window is the periodic Hann: zero at the first sample, one at the centre.
+        assert_eq!(window[0], 0.0);
+        assert!((window[n / 2] - 1.0).abs() < 1e-15);
     }
 
     #[test]

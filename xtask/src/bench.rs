@@ -11,7 +11,8 @@
 //! Writes a markdown table (`--markdown FILE`, default `bench.md`) and, with `--json FILE`, one
 //! JSON object. A benchmark, not a test: nothing here asserts on time.
 
-use crate::args::Args;
+use crate::args::number_in;
+use clap::Parser;
 use javari_core::analysis::{
     band_power, cents, peak_frequency_hz, power_spectrum, spectral_centroid_hz,
 };
@@ -29,11 +30,18 @@ use std::time::Instant;
 const SAMPLE_RATE: f64 = 44_100.0;
 const BLOCK: usize = 64;
 
-pub const HELP: &str = "cargo xtask bench [--seconds S] [--markdown FILE] [--json FILE]
-
-  --seconds S      simulated seconds per scene, 1 to 30 (default 3)
-  --markdown FILE  the results table (default bench.md)
-  --json FILE      also write the results as one JSON object";
+#[derive(Debug, Parser)]
+pub struct BenchArgs {
+    /// Simulated seconds per scene (1 to 30).
+    #[arg(long, value_name = "S", default_value_t = 3.0, value_parser = number_in(1.0, 30.0))]
+    seconds: f64,
+    /// The results table.
+    #[arg(long, value_name = "FILE", default_value = "bench.md")]
+    markdown: PathBuf,
+    /// Also write the results as one JSON object.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+}
 
 /// One measured (tier, scene) pair.
 #[derive(Debug, Clone)]
@@ -695,16 +703,12 @@ pub fn to_markdown(machine: &str, results: &[BenchResult]) -> String {
     text
 }
 
-pub fn run(raw: &[String]) -> Result<(), Box<dyn Error>> {
-    if raw.iter().any(|word| word == "--help" || word == "-h") {
-        println!("{HELP}");
-        return Ok(());
-    }
-    let mut args = Args::parse(raw, &[])?;
-    let seconds = args.number("seconds", 3.0, 1.0, 30.0)?;
-    let markdown = PathBuf::from(args.text("markdown").unwrap_or_else(|| "bench.md".into()));
-    let json = args.text("json").map(PathBuf::from);
-    args.finish()?;
+pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
+    let BenchArgs {
+        seconds,
+        markdown,
+        json,
+    } = args;
     let machine = machine_name();
     let results = run_all(seconds);
     let economy = run_economy(seconds);

@@ -1,18 +1,24 @@
-//! PNG figures without system libraries: a small RGB rasteriser, a built-in 5×7 bitmap font, line
-//! plots with axes and ticks (linear or log₁₀, an optional right-hand axis), and heat maps for
-//! spectrograms. Encoding is the pure-Rust `png` crate; nothing here needs fontconfig.
+//! PNG figures with `plotters` (bitmap backend, text by `ab_glyph`): line plots (linear or log₁₀
+//! y, an optional right-hand axis, dashed series, ringed points) and heat maps for spectrograms.
+//! The font is compiled in (`epaint_default_fonts`' Ubuntu Light, Ubuntu Font Licence) and the
+//! pixels are encoded by the `png` crate, so nothing here needs fontconfig or system fonts.
 
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::{register_font, FontStyle};
+use std::error::Error;
 use std::fmt;
 use std::fs::File;
 use std::io::BufWriter;
+use std::ops::Range;
 use std::path::Path;
+use std::sync::Once;
 
 /// An RGB colour.
 pub type Rgb = [u8; 3];
 
-pub const WHITE: Rgb = [255, 255, 255];
-pub const BLACK: Rgb = [0, 0, 0];
-pub const GREY: Rgb = [200, 200, 200];
 /// Distinguishable series colours (Okabe–Ito palette).
 pub const PALETTE: [Rgb; 7] = [
     [0, 114, 178],
@@ -34,216 +40,9 @@ impl fmt::Display for PlotError {
     }
 }
 
-impl std::error::Error for PlotError {}
+impl Error for PlotError {}
 
-/// An RGB pixel buffer.
-pub struct Canvas {
-    width: usize,
-    height: usize,
-    pixels: Vec<u8>,
-}
-
-impl Canvas {
-    /// A canvas filled with `background`.
-    pub fn new(width: usize, height: usize, background: Rgb) -> Self {
-        let mut pixels = Vec::with_capacity(width * height * 3);
-        for _ in 0..width * height {
-            pixels.extend_from_slice(&background);
-        }
-        Self {
-            width,
-            height,
-            pixels,
-        }
-    }
-
-    /// Sets one pixel; coordinates outside the canvas are ignored.
-    pub fn set(&mut self, x: i64, y: i64, colour: Rgb) {
-        if x >= 0 && y >= 0 && (x as usize) < self.width && (y as usize) < self.height {
-            let index = 3 * (y as usize * self.width + x as usize);
-            self.pixels[index..index + 3].copy_from_slice(&colour);
-        }
-    }
-
-    /// A filled rectangle, corners inclusive.
-    pub fn fill_rect(&mut self, x0: i64, y0: i64, x1: i64, y1: i64, colour: Rgb) {
-        for y in y0.min(y1)..=y0.max(y1) {
-            for x in x0.min(x1)..=x0.max(x1) {
-                self.set(x, y, colour);
-            }
-        }
-    }
-
-    /// A line `thickness` pixels wide; `dash` = (on, off) lengths in pixels, or `None` for solid.
-    pub fn line(
-        &mut self,
-        from: (f64, f64),
-        to: (f64, f64),
-        colour: Rgb,
-        thickness: i64,
-        dash: Option<(f64, f64)>,
-    ) {
-        let (dx, dy) = (to.0 - from.0, to.1 - from.1);
-        let length = dx.hypot(dy);
-        let steps = length.ceil().max(1.0) as usize;
-        let half = thickness / 2;
-        for step in 0..=steps {
-            let travelled = length * step as f64 / steps as f64;
-            if let Some((on, off)) = dash {
-                if travelled % (on + off) > on {
-                    continue;
-                }
-            }
-            let t = step as f64 / steps as f64;
-            let (x, y) = (
-                (from.0 + t * dx).round() as i64,
-                (from.1 + t * dy).round() as i64,
-            );
-            self.fill_rect(
-                x - half,
-                y - half,
-                x - half + thickness - 1,
-                y - half + thickness - 1,
-                colour,
-            );
-        }
-    }
-
-    /// A hollow circle of radius `radius`, used to ring marked points.
-    pub fn ring(&mut self, centre: (f64, f64), radius: f64, colour: Rgb) {
-        let steps = (radius * 8.0).ceil() as usize;
-        for step in 0..steps {
-            let angle = std::f64::consts::TAU * step as f64 / steps as f64;
-            self.set(
-                (centre.0 + radius * angle.cos()).round() as i64,
-                (centre.1 + radius * angle.sin()).round() as i64,
-                colour,
-            );
-        }
-    }
-
-    /// Text in the built-in 5×7 font magnified by `scale`; returns the width drawn.
-    pub fn text(&mut self, x: i64, y: i64, text: &str, colour: Rgb, scale: i64) -> i64 {
-        let mut cursor = x;
-        for character in text.chars() {
-            let rows = glyph(character);
-            for (row, bits) in rows.iter().enumerate() {
-                for column in 0..5 {
-                    if bits & (0b10000 >> column) != 0 {
-                        let (px, py) = (cursor + column * scale, y + row as i64 * scale);
-                        self.fill_rect(px, py, px + scale - 1, py + scale - 1, colour);
-                    }
-                }
-            }
-            cursor += 6 * scale;
-        }
-        cursor - x
-    }
-
-    /// Text rotated a quarter turn anticlockwise (for a y-axis label), starting at the bottom.
-    pub fn text_vertical(&mut self, x: i64, y: i64, text: &str, colour: Rgb, scale: i64) {
-        let mut cursor = y;
-        for character in text.chars() {
-            let rows = glyph(character);
-            for (row, bits) in rows.iter().enumerate() {
-                for column in 0..5 {
-                    if bits & (0b10000 >> column) != 0 {
-                        let (px, py) = (x + row as i64 * scale, cursor - column * scale);
-                        self.fill_rect(px, py, px + scale - 1, py + scale - 1, colour);
-                    }
-                }
-            }
-            cursor -= 6 * scale;
-        }
-    }
-
-    /// Writes the canvas as an 8-bit RGB PNG.
-    pub fn save_png(&self, path: &Path) -> Result<(), PlotError> {
-        let io_error = |error: &dyn fmt::Display| PlotError(format!("{}: {error}", path.display()));
-        let file = File::create(path).map_err(|error| io_error(&error))?;
-        let mut encoder =
-            png::Encoder::new(BufWriter::new(file), self.width as u32, self.height as u32);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let mut writer = encoder.write_header().map_err(|error| io_error(&error))?;
-        writer
-            .write_image_data(&self.pixels)
-            .map_err(|error| io_error(&error))?;
-        writer.finish().map_err(|error| io_error(&error))
-    }
-}
-
-/// Width in pixels of `text` at `scale`.
-pub fn text_width(text: &str, scale: i64) -> i64 {
-    6 * scale * text.chars().count() as i64
-}
-
-/// The 5×7 glyph of `character` (rows top to bottom, bit 4 = leftmost column). Lower case is
-/// drawn as upper case; an unknown character is drawn as a box.
-fn glyph(character: char) -> [u8; 7] {
-    match character.to_ascii_uppercase() {
-        ' ' => [0; 7],
-        '0' => [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E],
-        '1' => [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        '2' => [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F],
-        '3' => [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E],
-        '4' => [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02],
-        '5' => [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E],
-        '6' => [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E],
-        '7' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08],
-        '8' => [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E],
-        '9' => [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C],
-        'A' => [0x0E, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
-        'B' => [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E],
-        'C' => [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E],
-        'D' => [0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C],
-        'E' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F],
-        'F' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10],
-        'G' => [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F],
-        'H' => [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
-        'I' => [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        'J' => [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C],
-        'K' => [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11],
-        'L' => [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F],
-        'M' => [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11],
-        'N' => [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11],
-        'O' => [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'P' => [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10],
-        'Q' => [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D],
-        'R' => [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11],
-        'S' => [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E],
-        'T' => [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04],
-        'U' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'V' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04],
-        'W' => [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A],
-        'X' => [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11],
-        'Y' => [0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04],
-        'Z' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F],
-        '.' => [0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C],
-        ',' => [0x00, 0x00, 0x00, 0x00, 0x0C, 0x04, 0x08],
-        '-' => [0x00, 0x00, 0x00, 0x1F, 0x00, 0x00, 0x00],
-        '+' => [0x00, 0x04, 0x04, 0x1F, 0x04, 0x04, 0x00],
-        '=' => [0x00, 0x00, 0x1F, 0x00, 0x1F, 0x00, 0x00],
-        ':' => [0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x0C, 0x00],
-        ';' => [0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x04, 0x08],
-        '\'' => [0x04, 0x04, 0x08, 0x00, 0x00, 0x00, 0x00],
-        '/' => [0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00],
-        '(' => [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02],
-        ')' => [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08],
-        '[' => [0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E],
-        ']' => [0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E],
-        '_' => [0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1F],
-        '%' => [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03],
-        '*' => [0x00, 0x04, 0x15, 0x0E, 0x15, 0x04, 0x00],
-        '<' => [0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02],
-        '>' => [0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08],
-        '|' => [0x04; 7],
-        '^' => [0x04, 0x0A, 0x11, 0x00, 0x00, 0x00, 0x00],
-        _ => [0x1F, 0x11, 0x11, 0x11, 0x11, 0x11, 0x1F],
-    }
-}
-
-/// How an axis maps data to pixels.
+/// How the y axis maps data to pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum AxisScale {
     Linear,
@@ -256,9 +55,6 @@ pub enum AxisScale {
 pub enum SeriesStyle {
     Solid,
     Dashed,
-    /// Small filled squares at the points, no line.
-    #[allow(dead_code)] // Part of the shared plotting API; the stability sweeps draw lines.
-    Points,
 }
 
 /// One data series.
@@ -300,97 +96,47 @@ pub struct LinePlot {
     pub series: Vec<Series>,
 }
 
-/// Figure geometry.
-const WIDTH: usize = 1000;
-const HEIGHT: usize = 640;
-const LEFT: i64 = 110;
-const RIGHT_MARGIN: i64 = 110;
-const TOP: i64 = 60;
-const BOTTOM: i64 = 90;
-const FONT: i64 = 2;
+/// Figure size, pixels.
+pub const WIDTH: u32 = 1000;
+pub const HEIGHT: u32 = 640;
+const FONT: &str = "sans-serif";
 
-/// An axis range and its ticks.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Axis {
-    pub scale: AxisScale,
-    pub min: f64,
-    pub max: f64,
-    pub ticks: Vec<f64>,
+fn rgb(colour: Rgb) -> RGBColor {
+    RGBColor(colour[0], colour[1], colour[2])
 }
 
-impl Axis {
-    /// A range covering `values` with "nice" ticks (1, 2, 5 × 10ⁿ, or decades for log₁₀).
-    pub fn fit(values: impl Iterator<Item = f64>, scale: AxisScale) -> Result<Self, PlotError> {
-        let usable: Vec<f64> = values
-            .filter(|value| value.is_finite() && (scale == AxisScale::Linear || *value > 0.0))
-            .collect();
-        let (low, high) = usable
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), &value| {
-                (low.min(value), high.max(value))
-            });
-        if !low.is_finite() {
-            return Err(PlotError("plot: no finite data to draw".into()));
-        }
-        Ok(match scale {
-            AxisScale::Linear => {
-                let (low, high) = if high > low {
-                    (low, high)
-                } else {
-                    (low - 0.5, high + 0.5)
-                };
-                let step = nice_step((high - low) / 6.0);
-                let min = (low / step).floor() * step;
-                let max = (high / step).ceil() * step;
-                let count = ((max - min) / step).round() as usize;
-                let ticks = (0..=count).map(|index| min + step * index as f64).collect();
-                Self {
-                    scale,
-                    min,
-                    max,
-                    ticks,
-                }
-            }
-            AxisScale::Log10 => {
-                let min_decade = low.log10().floor() as i32;
-                let max_decade = (high.log10().ceil() as i32).max(min_decade + 1);
-                let ticks = (min_decade..=max_decade)
-                    .map(|decade| 10f64.powi(decade))
-                    .collect();
-                Self {
-                    scale,
-                    min: 10f64.powi(min_decade),
-                    max: 10f64.powi(max_decade),
-                    ticks,
-                }
-            }
-        })
-    }
-
-    /// Position of `value` in [0, 1] along the axis (outside for values beyond the range).
-    pub fn fraction(&self, value: f64) -> f64 {
-        match self.scale {
-            AxisScale::Linear => (value - self.min) / (self.max - self.min),
-            AxisScale::Log10 => {
-                (value.log10() - self.min.log10()) / (self.max.log10() - self.min.log10())
-            }
-        }
-    }
+/// Registers the compiled-in font under the family name the figures use.
+fn register_fonts() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        register_font(FONT, FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT)
+            .unwrap_or_else(|_| panic!("the compiled-in font is a valid TrueType font"));
+    });
 }
 
-fn nice_step(rough: f64) -> f64 {
-    let magnitude = 10f64.powf(rough.log10().floor());
-    let mantissa = rough / magnitude;
-    let nice = if mantissa <= 1.0 {
-        1.0
-    } else if mantissa <= 2.0 {
-        2.0
-    } else if mantissa <= 5.0 {
-        5.0
-    } else {
-        10.0
-    };
-    nice * magnitude
+/// The range of the finite `values` (positive ones only for log₁₀): exact for a linear axis
+/// (plotters picks the ticks), widened to whole decades for log₁₀.
+fn data_range(
+    values: impl Iterator<Item = f64>,
+    scale: AxisScale,
+) -> Result<Range<f64>, PlotError> {
+    let (low, high) = values
+        .filter(|value| value.is_finite() && (scale == AxisScale::Linear || *value > 0.0))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), value| {
+            (low.min(value), high.max(value))
+        });
+    if !low.is_finite() {
+        return Err(PlotError("plot: no finite data to draw".into()));
+    }
+    Ok(match scale {
+        AxisScale::Linear if high > low => low..high,
+        AxisScale::Linear => low - 0.5..high + 0.5,
+        AxisScale::Log10 => {
+            let low_decade = low.log10().floor() as i32;
+            let high_decade = (high.log10().ceil() as i32).max(low_decade + 1);
+            10f64.powi(low_decade)..10f64.powi(high_decade)
+        }
+    })
 }
 
 /// Tick label: short, no trailing zeros.
@@ -406,198 +152,165 @@ pub fn tick_label(value: f64) -> String {
     text.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// Draws into an RGB buffer of the figure's size and writes it to `path` as an 8-bit PNG.
+fn write_png(
+    path: &Path,
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), Box<dyn Error>>,
+) -> Result<(), PlotError> {
+    register_fonts();
+    let context = |error: &dyn fmt::Display| PlotError(format!("{}: {error}", path.display()));
+    let mut pixels = vec![0u8; 3 * WIDTH as usize * HEIGHT as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(|error| context(&error))?;
+        draw(&root).map_err(|error| context(&error))?;
+        root.present().map_err(|error| context(&error))?;
+    }
+    let file = File::create(path).map_err(|error| context(&error))?;
+    let mut encoder = png::Encoder::new(BufWriter::new(file), WIDTH, HEIGHT);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().map_err(|error| context(&error))?;
+    writer
+        .write_image_data(&pixels)
+        .map_err(|error| context(&error))?;
+    writer.finish().map_err(|error| context(&error))
+}
+
 /// Draws `plot` into a PNG at `path`.
 pub fn line_plot(path: &Path, plot: &LinePlot) -> Result<(), PlotError> {
-    let left_series = plot.series.iter().filter(|series| !series.right_axis);
-    let y_axis = Axis::fit(
-        left_series.flat_map(|series| series.points.iter().map(|point| point.1)),
-        plot.y_scale,
-    )?;
-    let x_axis = Axis::fit(
+    let y_values = |right: bool| {
+        plot.series
+            .iter()
+            .filter(move |series| series.right_axis == right)
+            .flat_map(|series| series.points.iter().map(|point| point.1))
+    };
+    let x_range = data_range(
         plot.series
             .iter()
             .flat_map(|series| series.points.iter().map(|point| point.0)),
         AxisScale::Linear,
     )?;
-    let right_axis = if plot.series.iter().any(|series| series.right_axis) {
-        Some(Axis::fit(
-            plot.series
-                .iter()
-                .filter(|series| series.right_axis)
-                .flat_map(|series| series.points.iter().map(|point| point.1)),
-            AxisScale::Linear,
-        )?)
+    let y_range = data_range(y_values(false), plot.y_scale)?;
+    let right_range = if plot.series.iter().any(|series| series.right_axis) {
+        Some(data_range(y_values(true), AxisScale::Linear)?)
     } else {
         None
     };
+    write_png(path, |root| match plot.y_scale {
+        AxisScale::Linear => draw_lines(root, plot, x_range, y_range, right_range),
+        AxisScale::Log10 => draw_lines(root, plot, x_range, y_range.log_scale(), right_range),
+    })
+}
 
-    let mut canvas = Canvas::new(WIDTH, HEIGHT, WHITE);
-    let (x0, x1) = (LEFT, WIDTH as i64 - RIGHT_MARGIN);
-    let (y0, y1) = (HEIGHT as i64 - BOTTOM, TOP);
-    let to_pixel = |axis_x: &Axis, axis_y: &Axis, point: (f64, f64)| {
-        (
-            x0 as f64 + axis_x.fraction(point.0) * (x1 - x0) as f64,
-            y0 as f64 + axis_y.fraction(point.1) * (y1 - y0) as f64,
-        )
-    };
-
-    // Grid and ticks.
-    for &tick in &x_axis.ticks {
-        let x = to_pixel(&x_axis, &y_axis, (tick, y_axis.min)).0;
-        canvas.line((x, y0 as f64), (x, y1 as f64), GREY, 1, None);
-        let label = tick_label(tick);
-        canvas.text(
-            x.round() as i64 - text_width(&label, FONT) / 2,
-            y0 + 10,
-            &label,
-            BLACK,
-            FONT,
-        );
+/// The line plot on a y axis of type `Y` (linear or logarithmic).
+fn draw_lines<Y>(
+    root: &DrawingArea<BitMapBackend<'_>, Shift>,
+    plot: &LinePlot,
+    x_range: Range<f64>,
+    y_range: Y,
+    right_range: Option<Range<f64>>,
+) -> Result<(), Box<dyn Error>>
+where
+    Y: AsRangedCoord<Value = f64>,
+    Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64> + 'static,
+{
+    let log_y = plot.y_scale == AxisScale::Log10;
+    let mut chart = ChartBuilder::on(root)
+        .caption(&plot.title, (FONT, 24))
+        .margin(16)
+        .x_label_area_size(60)
+        .y_label_area_size(90)
+        .right_y_label_area_size(if right_range.is_some() { 80 } else { 0 })
+        .build_cartesian_2d(x_range.clone(), y_range)?
+        .set_secondary_coord(x_range, right_range.clone().unwrap_or(0.0..1.0));
+    chart
+        .configure_mesh()
+        .x_desc(&plot.x_label)
+        .y_desc(&plot.y_label)
+        .label_style((FONT, 18))
+        .axis_desc_style((FONT, 20))
+        .x_label_formatter(&|value| tick_label(*value))
+        .y_label_formatter(&|value| tick_label(*value))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()?;
+    if let (Some(_), Some(label)) = (&right_range, &plot.right_label) {
+        chart
+            .configure_secondary_axes()
+            .y_desc(label)
+            .label_style((FONT, 18))
+            .axis_desc_style((FONT, 20))
+            .y_label_formatter(&|value| tick_label(*value))
+            .draw()?;
     }
-    for &tick in &y_axis.ticks {
-        let y = to_pixel(&x_axis, &y_axis, (x_axis.min, tick)).1;
-        canvas.line((x0 as f64, y), (x1 as f64, y), GREY, 1, None);
-        let label = tick_label(tick);
-        canvas.text(
-            x0 - 8 - text_width(&label, FONT),
-            y.round() as i64 - 7,
-            &label,
-            BLACK,
-            FONT,
-        );
-    }
-    if let Some(axis) = &right_axis {
-        for &tick in &axis.ticks {
-            let y = to_pixel(&x_axis, axis, (x_axis.min, tick)).1;
-            canvas.line((x1 as f64, y), (x1 as f64 + 6.0, y), BLACK, 1, None);
-            canvas.text(
-                x1 + 10,
-                y.round() as i64 - 7,
-                &tick_label(tick),
-                BLACK,
-                FONT,
-            );
-        }
-    }
-    // Frame.
-    for (from, to) in [
-        ((x0, y0), (x1, y0)),
-        ((x1, y0), (x1, y1)),
-        ((x1, y1), (x0, y1)),
-        ((x0, y1), (x0, y0)),
-    ] {
-        canvas.line(
-            (from.0 as f64, from.1 as f64),
-            (to.0 as f64, to.1 as f64),
-            BLACK,
-            2,
-            None,
-        );
-    }
-    // Labels.
-    canvas.text(
-        (WIDTH as i64 - text_width(&plot.title, FONT)) / 2,
-        18,
-        &plot.title,
-        BLACK,
-        FONT,
-    );
-    canvas.text(
-        (x0 + x1 - text_width(&plot.x_label, FONT)) / 2,
-        y0 + 40,
-        &plot.x_label,
-        BLACK,
-        FONT,
-    );
-    canvas.text_vertical(
-        14,
-        (y0 + y1 + text_width(&plot.y_label, FONT)) / 2,
-        &plot.y_label,
-        BLACK,
-        FONT,
-    );
-    if let Some(label) = &plot.right_label {
-        canvas.text_vertical(
-            WIDTH as i64 - 30,
-            (y0 + y1 + text_width(label, FONT)) / 2,
-            label,
-            BLACK,
-            FONT,
-        );
-    }
-
-    // Data, clipped to the frame.
-    let inside = |(x, y): (f64, f64)| {
-        x >= x0 as f64 - 0.5 && x <= x1 as f64 + 0.5 && y <= y0 as f64 + 0.5 && y >= y1 as f64 - 0.5
-    };
     for series in &plot.series {
-        let axis_y = if series.right_axis {
-            right_axis.as_ref().unwrap_or(&y_axis)
-        } else {
-            &y_axis
-        };
-        let drawable = |point: &(f64, f64)| {
+        let colour = rgb(series.colour);
+        let style = colour.stroke_width(2);
+        let drawable = |point: &&(f64, f64)| {
             point.0.is_finite()
                 && point.1.is_finite()
-                && (axis_y.scale == AxisScale::Linear || point.1 > 0.0)
+                && (series.right_axis || !log_y || point.1 > 0.0)
         };
-        let pixels: Vec<Option<(f64, f64)>> = series
+        // A gap in the data (a point that cannot be drawn) breaks the line.
+        let runs: Vec<Vec<(f64, f64)>> = series
             .points
-            .iter()
-            .map(|point| drawable(point).then(|| to_pixel(&x_axis, axis_y, *point)))
+            .split(|point| !drawable(&point))
+            .filter(|run| !run.is_empty())
+            .map(<[(f64, f64)]>::to_vec)
             .collect();
-        match series.style {
-            SeriesStyle::Points => {
-                for pixel in pixels.iter().flatten().filter(|pixel| inside(**pixel)) {
-                    let (x, y) = (pixel.0.round() as i64, pixel.1.round() as i64);
-                    canvas.fill_rect(x - 2, y - 2, x + 2, y + 2, series.colour);
+        let ringed: Vec<(f64, f64)> = series.ringed.iter().filter(drawable).copied().collect();
+        let mut labelled = false;
+        for run in runs {
+            let annotation = match (series.style, series.right_axis) {
+                (SeriesStyle::Solid, false) => chart.draw_series(LineSeries::new(run, style))?,
+                (SeriesStyle::Dashed, false) => {
+                    chart.draw_series(DashedLineSeries::new(run, 8, 6, style))?
                 }
-            }
-            SeriesStyle::Solid | SeriesStyle::Dashed => {
-                let dash = (series.style == SeriesStyle::Dashed).then_some((8.0, 6.0));
-                for pair in pixels.windows(2) {
-                    if let [Some(from), Some(to)] = pair {
-                        if inside(*from) && inside(*to) {
-                            canvas.line(*from, *to, series.colour, 2, dash);
-                        }
-                    }
+                (SeriesStyle::Solid, true) => {
+                    chart.draw_secondary_series(LineSeries::new(run, style))?
                 }
+                (SeriesStyle::Dashed, true) => {
+                    chart.draw_secondary_series(DashedLineSeries::new(run, 8, 6, style))?
+                }
+            };
+            if !labelled && !series.label.is_empty() {
+                labelled = true;
+                annotation.label(&series.label).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
+                });
             }
         }
-        for point in series.ringed.iter().filter(|point| drawable(point)) {
-            let pixel = to_pixel(&x_axis, axis_y, *point);
-            if inside(pixel) {
-                canvas.ring(pixel, 7.0, series.colour);
-                canvas.ring(pixel, 8.0, series.colour);
-            }
+        let ring = |point: (f64, f64)| Circle::new(point, 8, colour.stroke_width(2));
+        if series.right_axis {
+            chart.draw_secondary_series(ringed.into_iter().map(ring))?;
+        } else {
+            chart.draw_series(ringed.into_iter().map(ring))?;
         }
     }
-    // Legend, top right inside the frame.
-    let mut legend_y = y1 + 10;
-    for series in plot.series.iter().filter(|series| !series.label.is_empty()) {
-        let width = text_width(&series.label, FONT);
-        let x = x1 - 20 - width - 40;
-        match series.style {
-            SeriesStyle::Points => {
-                canvas.fill_rect(x + 13, legend_y + 4, x + 19, legend_y + 10, series.colour)
-            }
-            SeriesStyle::Solid | SeriesStyle::Dashed => canvas.line(
-                (x as f64, legend_y as f64 + 7.0),
-                (x as f64 + 32.0, legend_y as f64 + 7.0),
-                series.colour,
-                2,
-                (series.style == SeriesStyle::Dashed).then_some((8.0, 6.0)),
-            ),
-        }
-        canvas.text(x + 40, legend_y, &series.label, BLACK, FONT);
-        legend_y += 20;
-    }
-    canvas.save_png(path)
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font((FONT, 18))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
+/// The heat map's colours for levels in [0, 1]: dark blue → magenta → orange → pale yellow.
+fn colour_map() -> DerivedColorMap<RGBColor> {
+    DerivedColorMap::new(&[
+        RGBColor(0, 0, 4),
+        RGBColor(59, 15, 112),
+        RGBColor(140, 41, 129),
+        RGBColor(241, 96, 93),
+        RGBColor(252, 253, 191),
+    ])
 }
 
 /// A heat map (e.g. a spectrogram): `values[row * columns + column]`, row 0 at the bottom,
-/// mapped linearly from `value_range` onto a dark-to-bright colour ramp and clamped. The x and y
-/// ranges label the axes (e.g. seconds and hertz).
+/// mapped linearly from `value_range` onto a dark-to-bright colour map and clamped, with a colour
+/// bar. The x and y ranges label the axes (e.g. seconds and hertz).
 #[allow(clippy::too_many_arguments)]
 pub fn heatmap(
     path: &Path,
@@ -620,139 +333,100 @@ pub fn heatmap(
             "heatmap: value range {value_range:?} must be increasing"
         )));
     }
+    let spans_positive =
+        |range: (f64, f64)| range.1 > range.0 && range.0.is_finite() && range.1.is_finite();
+    if !spans_positive(x_range) || !spans_positive(y_range) {
+        return Err(PlotError(format!(
+            "heatmap: axis ranges {x_range:?}, {y_range:?} must be finite and increasing"
+        )));
+    }
     let (title, x_label, y_label) = labels;
-    let mut canvas = Canvas::new(WIDTH, HEIGHT, WHITE);
-    let (x0, x1) = (LEFT, WIDTH as i64 - RIGHT_MARGIN);
-    let (y0, y1) = (HEIGHT as i64 - BOTTOM, TOP);
-    for py in y1..=y0 {
-        let row_fraction = (y0 - py) as f64 / (y0 - y1 + 1) as f64;
-        let row = ((row_fraction * rows as f64) as usize).min(rows - 1);
-        for px in x0..=x1 {
-            let column_fraction = (px - x0) as f64 / (x1 - x0 + 1) as f64;
-            let column = ((column_fraction * columns as f64) as usize).min(columns - 1);
-            let value = values[row * columns + column];
-            let level = ((value - value_range.0) / (value_range.1 - value_range.0)).clamp(0.0, 1.0);
-            canvas.set(
-                px,
-                py,
-                colour_ramp(if value.is_finite() { level } else { 0.0 }),
-            );
+    let map = colour_map();
+    let level = |value: f64| {
+        let level = (value - value_range.0) / (value_range.1 - value_range.0);
+        if level.is_finite() {
+            level.clamp(0.0, 1.0)
+        } else {
+            0.0
         }
-    }
-    let x_axis = Axis::fit([x_range.0, x_range.1].into_iter(), AxisScale::Linear)?;
-    let y_axis = Axis::fit([y_range.0, y_range.1].into_iter(), AxisScale::Linear)?;
-    let span = |range: (f64, f64), value: f64| (value - range.0) / (range.1 - range.0);
-    for &tick in x_axis
-        .ticks
-        .iter()
-        .filter(|tick| (x_range.0..=x_range.1).contains(*tick))
-    {
-        let x = x0 as f64 + span(x_range, tick) * (x1 - x0) as f64;
-        canvas.line((x, y0 as f64), (x, y0 as f64 + 6.0), BLACK, 1, None);
-        let label = tick_label(tick);
-        canvas.text(
-            x.round() as i64 - text_width(&label, FONT) / 2,
-            y0 + 10,
-            &label,
-            BLACK,
-            FONT,
-        );
-    }
-    for &tick in y_axis
-        .ticks
-        .iter()
-        .filter(|tick| (y_range.0..=y_range.1).contains(*tick))
-    {
-        let y = y0 as f64 + span(y_range, tick) * (y1 - y0) as f64;
-        canvas.line((x0 as f64 - 6.0, y), (x0 as f64, y), BLACK, 1, None);
-        let label = tick_label(tick);
-        canvas.text(
-            x0 - 10 - text_width(&label, FONT),
-            y.round() as i64 - 7,
-            &label,
-            BLACK,
-            FONT,
-        );
-    }
-    // Colour bar on the right.
-    for py in y1..=y0 {
-        let level = (y0 - py) as f64 / (y0 - y1) as f64;
-        canvas.fill_rect(x1 + 20, py, x1 + 40, py, colour_ramp(level));
-    }
-    canvas.text(x1 + 44, y1, &tick_label(value_range.1), BLACK, FONT);
-    canvas.text(x1 + 44, y0 - 14, &tick_label(value_range.0), BLACK, FONT);
-    canvas.text(
-        (WIDTH as i64 - text_width(title, FONT)) / 2,
-        18,
-        title,
-        BLACK,
-        FONT,
-    );
-    canvas.text(
-        (x0 + x1 - text_width(x_label, FONT)) / 2,
-        y0 + 40,
-        x_label,
-        BLACK,
-        FONT,
-    );
-    canvas.text_vertical(
-        14,
-        (y0 + y1 + text_width(y_label, FONT)) / 2,
-        y_label,
-        BLACK,
-        FONT,
-    );
-    canvas.save_png(path)
-}
+    };
+    write_png(path, |root| {
+        let root = root.titled(title, (FONT, 24))?;
+        let (main, bar) = root.split_horizontally(WIDTH - 130);
+        let mut chart = ChartBuilder::on(&main)
+            .margin(16)
+            .x_label_area_size(60)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .label_style((FONT, 18))
+            .axis_desc_style((FONT, 20))
+            .x_label_formatter(&|value| tick_label(*value))
+            .y_label_formatter(&|value| tick_label(*value))
+            .draw()?;
+        let cell_width = (x_range.1 - x_range.0) / columns as f64;
+        let cell_height = (y_range.1 - y_range.0) / rows as f64;
+        chart.draw_series((0..rows * columns).map(|index| {
+            let (row, column) = (index / columns, index % columns);
+            let x = x_range.0 + column as f64 * cell_width;
+            let y = y_range.0 + row as f64 * cell_height;
+            let colour = map.get_color(level(values[index]));
+            Rectangle::new([(x, y), (x + cell_width, y + cell_height)], colour.filled())
+        }))?;
 
-/// Dark blue → magenta → orange → pale yellow, for levels in [0, 1].
-#[allow(dead_code)] // Used by `heatmap`.
-pub fn colour_ramp(level: f64) -> Rgb {
-    const STOPS: [(f64, Rgb); 5] = [
-        (0.0, [0, 0, 4]),
-        (0.25, [59, 15, 112]),
-        (0.5, [140, 41, 129]),
-        (0.75, [241, 96, 93]),
-        (1.0, [252, 253, 191]),
-    ];
-    let level = level.clamp(0.0, 1.0);
-    for pair in STOPS.windows(2) {
-        let ((low, from), (high, to)) = (pair[0], pair[1]);
-        if level <= high {
-            let t = (level - low) / (high - low);
-            let mix = |a: u8, b: u8| (a as f64 + t * (b as f64 - a as f64)).round() as u8;
-            return [
-                mix(from[0], to[0]),
-                mix(from[1], to[1]),
-                mix(from[2], to[2]),
-            ];
-        }
-    }
-    STOPS[STOPS.len() - 1].1
+        // The colour bar: the value range, bottom to top.
+        let mut scale: ChartContext<'_, _, Cartesian2d<RangedCoordf64, RangedCoordf64>> =
+            ChartBuilder::on(&bar)
+                .margin_top(16)
+                .margin_bottom(76)
+                .margin_right(16)
+                .y_label_area_size(60)
+                .build_cartesian_2d(0.0..1.0, value_range.0..value_range.1)?;
+        scale
+            .configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .label_style((FONT, 18))
+            .y_label_formatter(&|value| tick_label(*value))
+            .draw()?;
+        const STEPS: usize = 256;
+        let step = (value_range.1 - value_range.0) / STEPS as f64;
+        scale.draw_series((0..STEPS).map(|index| {
+            let low = value_range.0 + index as f64 * step;
+            let colour = map.get_color((index as f64 + 0.5) / STEPS as f64);
+            Rectangle::new([(0.0, low), (1.0, low + step)], colour.filled())
+        }))?;
+        Ok(())
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    #[test]
-    fn linear_axis_has_nice_ticks_covering_the_data() {
-        let axis = Axis::fit([0.13, 0.94].into_iter(), AxisScale::Linear).unwrap();
-        assert!(axis.min <= 0.13 && axis.max >= 0.94);
-        assert_eq!(axis.ticks.first().copied(), Some(axis.min));
-        let step = axis.ticks[1] - axis.ticks[0];
-        assert!(
-            (step - 0.2).abs() < 1e-12 || (step - 0.1).abs() < 1e-12,
-            "{step}"
-        );
+    /// Width, height and the number of distinct colours of a PNG file.
+    fn decode(path: &Path) -> (u32, u32, usize) {
+        let bytes = std::fs::read(path).unwrap();
+        let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+        let mut reader = decoder.read_info().unwrap();
+        let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+        let frame = reader.next_frame(&mut pixels).unwrap();
+        assert_eq!(frame.color_type, png::ColorType::Rgb);
+        let colours: std::collections::BTreeSet<&[u8]> =
+            pixels[..frame.buffer_size()].chunks(3).collect();
+        (frame.width, frame.height, colours.len())
     }
 
     #[test]
-    fn log_axis_spans_whole_decades() {
-        let axis = Axis::fit([0.7, 35.0, -1.0].into_iter(), AxisScale::Log10).unwrap();
-        assert_eq!((axis.min, axis.max), (0.1, 100.0));
-        assert_eq!(axis.ticks.len(), 4);
-        assert!((axis.fraction(1.0) - 1.0 / 3.0).abs() < 1e-12);
+    fn log_range_spans_whole_decades() {
+        let range = data_range([0.7, 35.0, -1.0].into_iter(), AxisScale::Log10).unwrap();
+        assert_eq!(range, 0.1..100.0);
+        let range = data_range([2.0, 2.0].into_iter(), AxisScale::Linear).unwrap();
+        assert_eq!(range, 1.5..2.5);
     }
 
     #[test]
@@ -770,61 +444,68 @@ mod tests {
             y_label: "y".into(),
             y_scale: AxisScale::Linear,
             right_label: None,
-            series: vec![Series::new("nothing", vec![(f64::NAN, 1.0)], BLACK)],
+            series: vec![Series::new("nothing", vec![(f64::NAN, 1.0)], [0, 0, 0])],
         };
         let path = std::env::temp_dir().join("javari-plot-empty.png");
         assert!(line_plot(&path, &plot).is_err());
     }
 
     #[test]
-    fn plots_and_heatmaps_are_written_as_png() {
+    fn line_plots_are_written_as_png() {
         let directory = std::env::temp_dir();
         let mut series = Series::new("sine", Vec::new(), PALETTE[0]);
         series.points = (0..50)
-            .map(|i| (i as f64, (i as f64 / 8.0).sin()))
+            .map(|i| (i as f64, 2.0 + (i as f64 / 8.0).sin()))
             .collect();
-        series.ringed = vec![(10.0, (10.0f64 / 8.0).sin())];
-        let plot = LinePlot {
-            title: "test plot".into(),
-            x_label: "x".into(),
-            y_label: "y".into(),
-            y_scale: AxisScale::Linear,
-            right_label: None,
-            series: vec![series],
-        };
-        let line_path = directory.join("javari-plot-line.png");
-        line_plot(&line_path, &plot).unwrap();
-        let heat_path = directory.join("javari-plot-heat.png");
-        let values: Vec<f64> = (0..12).map(f64::from).collect();
-        heatmap(
-            &heat_path,
-            &values,
-            3,
-            4,
-            (0.0, 1.0),
-            (0.0, 100.0),
-            (0.0, 11.0),
-            ("t", "x", "y"),
-        )
-        .unwrap();
-        for path in [line_path, heat_path] {
-            let bytes = std::fs::read(&path).unwrap();
-            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
-            let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-            let reader = decoder.read_info().unwrap();
-            assert_eq!(reader.info().width as usize, WIDTH);
+        series.points[20].1 = f64::NAN;
+        series.ringed = vec![(10.0, 2.0 + (10.0f64 / 8.0).sin())];
+        let mut right = Series::new("order (right)", vec![(0.0, 1.0), (49.0, 4.0)], PALETTE[1]);
+        right.style = SeriesStyle::Dashed;
+        right.right_axis = true;
+        for y_scale in [AxisScale::Linear, AxisScale::Log10] {
+            let plot = LinePlot {
+                title: "test plot".into(),
+                x_label: "x".into(),
+                y_label: "y".into(),
+                y_scale,
+                right_label: Some("order".into()),
+                series: vec![series.clone(), right.clone()],
+            };
+            let path = directory.join(format!("javari-plot-line-{y_scale:?}.png"));
+            line_plot(&path, &plot).unwrap();
+            let (width, height, colours) = decode(&path);
+            assert_eq!((width, height), (WIDTH, HEIGHT));
+            // White, black text and axes, both series and the anti-aliased edges between.
+            assert!(colours > 10, "{colours} colours: blank?");
             std::fs::remove_file(path).unwrap();
         }
-        assert!(heatmap(
-            &directory.join("x.png"),
-            &values,
-            5,
-            4,
-            (0.0, 1.0),
-            (0.0, 1.0),
-            (0.0, 1.0),
-            ("", "", "")
-        )
-        .is_err());
+    }
+
+    #[test]
+    fn heatmaps_are_written_as_png() {
+        let directory = std::env::temp_dir();
+        let path = directory.join("javari-plot-heat.png");
+        let values: Vec<f64> = (0..12).map(f64::from).collect();
+        let heatmap_of = |path: &Path, rows| {
+            heatmap(
+                path,
+                &values,
+                rows,
+                4,
+                (0.0, 1.0),
+                (0.0, 100.0),
+                (0.0, 11.0),
+                ("t", "x", "y"),
+            )
+        };
+        heatmap_of(&path, 3).unwrap();
+        let (width, height, colours) = decode(&path);
+        assert_eq!((width, height), (WIDTH, HEIGHT));
+        assert!(
+            colours > 12,
+            "{colours} colours: the 12 cells should differ"
+        );
+        std::fs::remove_file(path).unwrap();
+        assert!(heatmap_of(&directory.join("x.png"), 5).is_err());
     }
 }

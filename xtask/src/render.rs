@@ -1,50 +1,77 @@
 //! `cargo xtask render`: MIDI file (or the built-in demo scene) to a WAV file, through the same
 //! engine the plugin runs (`javari_core::engine::render`).
 //!
-//! Options:
-//!   --midi FILE          standard MIDI file; without it the built-in demo scene is rendered
-//!   --preset FILE        preset file (presets/*.toml); default: the classic settings
-//!   --out FILE.wav       default out/demo.wav, or out/<midi name>.wav
-//!   --sample-rate HZ     8000–192000, default 44100
-//!   --block-size N       1–65536 samples per process call, default 512
-//!   --quality TIER       draft | live | studio | reference, or preset (default: the preset's
-//!                        own, else reference)
-//!   --tail-seconds S     0–60 s rendered after the last event, default 3
-//!   --plot FILE.png      spectrogram of the result
-//!
-//! The WAV file is mono, 32-bit float at full scale ±1. A progress bar goes to stderr.
+//! Options: `cargo xtask render --help`. The WAV file is mono, 32-bit float at full scale ±1. A
+//! progress bar goes to stderr.
 
-use crate::args::Args;
+use crate::args::number_in;
 use crate::plot::heatmap;
+use clap::builder::PossibleValuesParser;
+use clap::Parser;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use javari_core::analysis::power_spectrum;
 use javari_core::engine::bowed_stability::bowed_stability;
 use javari_core::engine::midi_file;
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::preset::{Preset, QUALITY_NAMES};
 use javari_core::engine::render::ScoreAction;
-use javari_core::engine::render::{render, rendered_length, RenderOptions, Score};
+use javari_core::engine::render::{render, render_with, rendered_length, RenderOptions, Score};
 use javari_core::engine::wav::write_wav;
-use javari_core::engine::{EngineEvent, EngineSettings, Instrument};
+use javari_core::engine::{EngineEvent, EngineSettings, Instrument, VoiceTask};
 use javari_core::tanpura::quality::Quality;
-use std::io::Write;
+use rayon::prelude::*;
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
-pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
-    let mut args = Args::parse(raw, &[])?;
-    let midi = args.text("midi").map(PathBuf::from);
-    let preset_path = args.text("preset").map(PathBuf::from);
-    let out = args.text("out").map(PathBuf::from);
-    let sample_rate_hz: f64 = args.number("sample-rate", 44_100.0, 8_000.0, 192_000.0)?;
-    let block_size: usize = args.number("block-size", 512, 1, 65_536)?;
-    // "preset" keeps the preset's own quality.
-    let mut quality_choices = QUALITY_NAMES.to_vec();
-    quality_choices.push("preset");
-    let quality = args.choice("quality", "preset", &quality_choices)?;
-    let quality = Quality::from_name(quality);
-    let tail_s: f64 = args.number("tail-seconds", 3.0, 0.0, 60.0)?;
-    let plot = args.text("plot").map(PathBuf::from);
-    args.finish()?;
+#[derive(Debug, Parser)]
+pub struct RenderArgs {
+    /// Standard MIDI file; without it the built-in demo scene is rendered.
+    #[arg(long, value_name = "FILE")]
+    midi: Option<PathBuf>,
+    /// Preset file (presets/*.toml); default: the classic settings.
+    #[arg(long, value_name = "FILE")]
+    preset: Option<PathBuf>,
+    /// Output WAV file; default out/demo.wav, or out/<midi name>.wav.
+    #[arg(long, value_name = "FILE.wav")]
+    out: Option<PathBuf>,
+    /// Output sample rate, Hz (8000 to 192000).
+    #[arg(long, value_name = "HZ", default_value_t = 44_100.0,
+          value_parser = number_in(8_000.0, 192_000.0))]
+    sample_rate: f64,
+    /// Samples per process call, as a host's buffer size (1 to 65536).
+    #[arg(long, value_name = "N", default_value_t = 512, value_parser = number_in(1usize, 65_536))]
+    block_size: usize,
+    /// Quality tier; `preset` keeps the preset's own (reference without a preset).
+    #[arg(long, value_name = "TIER", default_value = "preset",
+          value_parser = PossibleValuesParser::new(QUALITY_NAMES.into_iter().chain(["preset"])))]
+    quality: String,
+    /// Seconds rendered after the last event (0 to 60).
+    #[arg(long, value_name = "S", default_value_t = 3.0, value_parser = number_in(0.0, 60.0))]
+    tail_seconds: f64,
+    /// Also write a spectrogram of the result as a PNG.
+    #[arg(long, value_name = "FILE.png")]
+    plot: Option<PathBuf>,
+    /// Threads that run the voices (1 to 256; default: every core). The output is bit-identical
+    /// for any number.
+    #[arg(long, value_name = "N", value_parser = number_in(1usize, 256))]
+    jobs: Option<usize>,
+}
+
+pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let RenderArgs {
+        midi,
+        preset: preset_path,
+        out,
+        sample_rate: sample_rate_hz,
+        block_size,
+        quality,
+        tail_seconds: tail_s,
+        plot,
+        jobs,
+    } = args;
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
+    let quality = Quality::from_name(&quality);
 
     let (score, default_out) = match &midi {
         Some(path) => {
@@ -76,7 +103,7 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
 
     let total = rendered_length(&score, &options);
     eprintln!(
-        "rendering {} ({:.1} s at {} Hz, {} quality) to {}",
+        "rendering {} ({:.1} s at {} Hz, {} quality, {jobs} thread{}) to {}",
         midi.as_deref()
             .map_or("the demo scene".to_string(), |path| path
                 .display()
@@ -84,14 +111,15 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
         total as f64 / sample_rate_hz,
         sample_rate_hz,
         settings.voice.quality.name(),
+        if jobs == 1 { "" } else { "s" },
         out.display()
     );
     let started = Instant::now();
-    let mut bar = ProgressBar::new();
-    let signal = render(&settings, &score, &options, &mut |done, total| {
-        bar.update(done, total)
-    });
-    bar.finish();
+    let bar = progress_bar(total);
+    let signal = render_on(jobs, &settings, &score, &options, &mut |done, _| {
+        bar.set_position(done as u64)
+    })?;
+    bar.finish_and_clear();
     let elapsed_s = started.elapsed().as_secs_f64();
     write_wav(&out, &signal, sample_rate_hz)?;
     let peak = signal.iter().fold(0.0f32, |peak, x| peak.max(x.abs()));
@@ -108,6 +136,28 @@ pub fn run(raw: &[String]) -> Result<(), Box<dyn std::error::Error>> {
         eprintln!("wrote the spectrogram {}", plot.display());
     }
     Ok(())
+}
+
+/// [`render`] with the voices of each segment on `jobs` threads (rayon); one job renders on this
+/// thread exactly as the plugin does. The voices' outputs are summed in a fixed order
+/// ([`javari_core::engine::Engine::process_with`]), so the signal does not depend on `jobs`.
+fn render_on(
+    jobs: usize,
+    settings: &EngineSettings,
+    score: &Score,
+    options: &RenderOptions,
+    progress: &mut (dyn FnMut(usize, usize) + Send),
+) -> Result<Vec<f32>, rayon::ThreadPoolBuildError> {
+    if jobs <= 1 {
+        return Ok(render(settings, score, options, progress));
+    }
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
+    // The whole render runs inside the pool, so that handing out a segment's voices is a cheap
+    // fork-join among its threads.
+    Ok(pool.install(|| {
+        let runner = |tasks: &mut [VoiceTask<'_>]| tasks.par_iter_mut().for_each(VoiceTask::run);
+        render_with(settings, score, options, &runner, progress)
+    }))
 }
 
 /// Frame length and hop of the spectrogram, samples.
@@ -195,44 +245,47 @@ fn warn_if_bowed_preset_is_unstable(settings: &EngineSettings, score: &Score) {
     }
 }
 
-/// A one-line progress bar on stderr, redrawn when the percentage changes.
-struct ProgressBar {
-    last_percent: Option<usize>,
-    started: Instant,
+/// The render's progress bar on stderr (indicatif), hidden when stderr is not a terminal (a log
+/// file or CI gets the summary lines only).
+fn progress_bar(total: usize) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("[{bar:40}] {percent:>3}%  {eta} left")
+            .expect("a valid template")
+            .progress_chars("#> "),
+    );
+    bar
 }
 
-impl ProgressBar {
-    const WIDTH: usize = 40;
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-    fn new() -> Self {
-        Self {
-            last_percent: None,
-            started: Instant::now(),
+    #[test]
+    fn every_number_of_jobs_renders_the_same_bits() {
+        // Overlapping notes on several strings, so that several voices share each segment.
+        let mut score = Score::default();
+        for (index, note) in [43u8, 48, 52, 55, 36, 60].into_iter().enumerate() {
+            score.note(0.02 * index as f64, 0.2, note, 0.9);
         }
-    }
-
-    fn update(&mut self, done: usize, total: usize) {
-        let percent = (done * 100).checked_div(total).unwrap_or(100);
-        if self.last_percent == Some(percent) {
-            return;
-        }
-        self.last_percent = Some(percent);
-        let filled = percent * Self::WIDTH / 100;
-        let elapsed = self.started.elapsed().as_secs_f64();
-        let remaining = if done > 0 {
-            elapsed * (total - done) as f64 / done as f64
-        } else {
-            0.0
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = Quality::Draft;
+        let options = RenderOptions {
+            tail_s: 0.1,
+            block_size: 256,
+            ..RenderOptions::default()
         };
-        eprint!(
-            "\r[{}{}] {percent:3}%  {remaining:5.1} s left",
-            "#".repeat(filled),
-            " ".repeat(Self::WIDTH - filled)
-        );
-        let _ = std::io::stderr().flush();
-    }
-
-    fn finish(&self) {
-        eprintln!();
+        let bits = |jobs| {
+            let signal = render_on(jobs, &settings, &score, &options, &mut |_, _| {}).unwrap();
+            signal.iter().map(|x| x.to_bits()).collect::<Vec<u32>>()
+        };
+        let one = bits(1);
+        assert!(one.iter().any(|&x| f32::from_bits(x) != 0.0));
+        for jobs in [2, 3, 8] {
+            assert!(one == bits(jobs), "{jobs} jobs differ from one");
+        }
     }
 }

@@ -5,7 +5,8 @@
 //! (every step, or every `--every N` steps), and optionally a WAV of the nut force (minus its
 //! rest value) at the internal rate, normalised to its peak.
 
-use crate::args::{ArgError, Args};
+use crate::args::number_in;
+use clap::{Parser, ValueEnum};
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::geometry::ThreadSettings;
@@ -14,21 +15,72 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
-pub const HELP: &str = "cargo xtask simulate [options]
+#[derive(Debug, Clone, Copy, PartialEq, ValueEnum)]
+pub enum Excitation {
+    /// A finger pressed to static equilibrium and released.
+    Pluck,
+    /// The string's first linear mode.
+    FirstMode,
+}
 
-  --seconds S              simulated time, 0 < S <= 60 (default 1)
-  --lossless               gamma = eta = r = 0 (energy is then conserved to round-off)
-  --excitation KIND        pluck | first-mode (default pluck)
-  --thread on|off          the cotton thread (default on)
-  --bridge full|off-beyond-thread   k_b = 0 for x > x_c with off-beyond-thread (default full)
-  --kb K                   bridge stiffness k_b in N/m^2, 0 to 1e12 (default 1e8)
-  --thread-position-mm X   thread position from the tuning bead, 30 to 45 (default 40)
-  --pluck-position-mm X    pluck position from the tuning bead, 50 to 660 (default 350)
-  --pluck-amplitude-mm A   finger lift (pluck) or first-mode amplitude, 0 to 5 (default 2)
-  --oversample M           internal rate = M x 44.1 kHz, 1 to 16 (default 4, the seed's)
-  --every N                write every N-th step, 1 to 1000000 (default 1)
-  --out FILE.csv           CSV output (default simulate.csv)
-  --wav FILE.wav           also write the nut force as a WAV at the internal rate";
+#[derive(Debug, Clone, Copy, PartialEq, ValueEnum)]
+pub enum OnOff {
+    On,
+    Off,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, ValueEnum)]
+pub enum Bridge {
+    Full,
+    /// k_b = 0 for x > x_c.
+    OffBeyondThread,
+}
+
+#[derive(Debug, Parser)]
+pub struct SimulateArgs {
+    /// Simulated time, s (0 < S <= 60).
+    #[arg(long, value_name = "S", default_value_t = 1.0, value_parser = number_in(1e-6, 60.0))]
+    seconds: f64,
+    /// gamma = eta = r = 0 (energy is then conserved to round-off).
+    #[arg(long)]
+    lossless: bool,
+    /// How the string is set in motion.
+    #[arg(long, value_name = "KIND", value_enum, default_value_t = Excitation::Pluck)]
+    excitation: Excitation,
+    /// The cotton thread.
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    thread: OnOff,
+    /// Bridge contact everywhere, or none past the thread.
+    #[arg(long, value_enum, default_value_t = Bridge::Full)]
+    bridge: Bridge,
+    /// Bridge stiffness k_b, N/m^2 (0 to 1e12).
+    #[arg(long, value_name = "K", default_value_t = 1e8, value_parser = number_in(0.0, 1e12))]
+    kb: f64,
+    /// Thread position from the tuning bead, mm.
+    #[arg(long, value_name = "X", default_value_t = 40.0, value_parser = number_in(
+        ThreadSettings::POSITION_RANGE_M.0 * 1e3,
+        ThreadSettings::POSITION_RANGE_M.1 * 1e3,
+    ))]
+    thread_position_mm: f64,
+    /// Pluck position from the tuning bead, mm (50 to 660).
+    #[arg(long, value_name = "X", default_value_t = 350.0, value_parser = number_in(50.0, 660.0))]
+    pluck_position_mm: f64,
+    /// Finger lift (pluck) or first-mode amplitude, mm (0 to 5).
+    #[arg(long, value_name = "A", default_value_t = 2.0, value_parser = number_in(0.0, 5.0))]
+    pluck_amplitude_mm: f64,
+    /// Internal rate = M x 44.1 kHz (1 to 16; 4 is the seed's).
+    #[arg(long, value_name = "M", default_value_t = 4, value_parser = number_in(1usize, 16))]
+    oversample: usize,
+    /// Write every N-th step (1 to 1000000).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = number_in(1usize, 1_000_000))]
+    every: usize,
+    /// CSV output.
+    #[arg(long, value_name = "FILE.csv", default_value = "simulate.csv")]
+    out: PathBuf,
+    /// Also write the nut force as a WAV at the internal rate.
+    #[arg(long, value_name = "FILE.wav")]
+    wav: Option<PathBuf>,
+}
 
 /// Everything `simulate` needs, parsed and checked.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,69 +94,46 @@ pub struct SimulateOptions {
     pub wav: Option<PathBuf>,
 }
 
-pub fn parse(raw: &[String]) -> Result<SimulateOptions, ArgError> {
-    let mut args = Args::parse(raw, &["lossless"])?;
-    let seconds = args.number("seconds", 1.0, 1e-6, 60.0)?;
-    let lossless = args.flag("lossless");
-    let excitation = args.choice("excitation", "pluck", &["pluck", "first-mode"])?;
-    let thread = args.choice("thread", "on", &["on", "off"])?;
-    let bridge = args.choice("bridge", "full", &["full", "off-beyond-thread"])?;
-    let kb = args.number("kb", 1e8, 0.0, 1e12)?;
-    let (thread_min, thread_max) = ThreadSettings::POSITION_RANGE_M;
-    let thread_position_mm = args.number(
-        "thread-position-mm",
-        40.0,
-        thread_min * 1e3,
-        thread_max * 1e3,
-    )?;
-    let pluck_position_mm = args.number("pluck-position-mm", 350.0, 50.0, 660.0)?;
-    let amplitude_mm = args.number("pluck-amplitude-mm", 2.0, 0.0, 5.0)?;
-    let oversample: usize = args.number("oversample", 4, 1, 16)?;
-    let every: usize = args.number("every", 1, 1, 1_000_000)?;
-    let out = PathBuf::from(args.text("out").unwrap_or_else(|| "simulate.csv".into()));
-    let wav = args.text("wav").map(PathBuf::from);
-    args.finish()?;
-    if bridge == "off-beyond-thread" && thread == "off" {
-        return Err(ArgError(
+/// The string configuration and run options of the command line, or why they do not fit.
+pub fn options(args: SimulateArgs) -> Result<SimulateOptions, String> {
+    if args.bridge == Bridge::OffBeyondThread && args.thread == OnOff::Off {
+        return Err(
             "option `--bridge off-beyond-thread` needs `--thread on`: without a thread there is \
              no 'beyond the thread'"
                 .into(),
-        ));
+        );
     }
 
     let mut config = FdStringConfig::REFERENCE;
-    config.time_step_s = 1.0 / (44_100.0 * oversample as f64);
-    config.bridge.stiffness_n_m2 = kb;
-    config.bridge.beyond_thread = bridge == "full";
-    config.thread = (thread == "on").then_some(ThreadSettings {
-        position_m: thread_position_mm * 1e-3,
+    config.time_step_s = 1.0 / (44_100.0 * args.oversample as f64);
+    config.bridge.stiffness_n_m2 = args.kb;
+    config.bridge.beyond_thread = args.bridge == Bridge::Full;
+    config.thread = (args.thread == OnOff::On).then_some(ThreadSettings {
+        position_m: args.thread_position_mm * 1e-3,
         ..ThreadSettings::SEED
     });
-    if lossless {
+    if args.lossless {
         config = config.lossless();
     }
     config.track_energy = true;
     Ok(SimulateOptions {
-        seconds,
+        seconds: args.seconds,
         config,
-        first_mode: excitation == "first-mode",
+        first_mode: args.excitation == Excitation::FirstMode,
         pluck: Pluck {
-            position_m: pluck_position_mm * 1e-3,
-            amplitude_m: amplitude_mm * 1e-3,
+            position_m: args.pluck_position_mm * 1e-3,
+            amplitude_m: args.pluck_amplitude_mm * 1e-3,
             ..Pluck::default()
         },
-        every,
-        out,
-        wav,
+        every: args.every,
+        out: args.out,
+        wav: args.wav,
     })
 }
 
-pub fn run(raw: &[String]) -> Result<(), Box<dyn Error>> {
-    if raw.iter().any(|word| word == "--help" || word == "-h") {
-        println!("{HELP}");
-        return Ok(());
-    }
-    let options = parse(raw)?;
+pub fn run(args: SimulateArgs) -> Result<(), Box<dyn Error>> {
+    let options =
+        options(args).unwrap_or_else(|message| crate::usage_error("simulate", message).exit());
     let mut string = FdString::new(options.config);
     if options.first_mode {
         string.excite_first_mode(options.pluck.amplitude_m);
@@ -183,13 +212,16 @@ fn write_normalised_wav(
 mod tests {
     use super::*;
 
-    fn words(text: &str) -> Vec<String> {
-        text.split_whitespace().map(str::to_string).collect()
+    /// The options of a command line, or the error clap or the checks would print.
+    fn parse(line: &str) -> Result<SimulateOptions, String> {
+        let words = std::iter::once("simulate").chain(line.split_whitespace());
+        let args = SimulateArgs::try_parse_from(words).map_err(|error| error.to_string())?;
+        options(args)
     }
 
     #[test]
     fn defaults_are_the_seed_reference() {
-        let options = parse(&[]).unwrap();
+        let options = parse("").unwrap();
         assert_eq!(options.config.bridge, FdStringConfig::REFERENCE.bridge);
         assert_eq!(options.config.thread, FdStringConfig::REFERENCE.thread);
         assert_eq!(options.config.time_step_s, 1.0 / 176_400.0);
@@ -198,10 +230,10 @@ mod tests {
 
     #[test]
     fn lossless_and_layout_options_map_onto_the_model() {
-        let options = parse(&words(
+        let options = parse(
             "--lossless --thread-position-mm 42 --bridge off-beyond-thread --kb 1e9 \
              --excitation first-mode --oversample 8",
-        ))
+        )
         .unwrap();
         assert_eq!(options.config.string.gamma_per_s, 0.0);
         assert_eq!(options.config.bridge.damping_s_m, 0.0);
@@ -214,13 +246,18 @@ mod tests {
 
     #[test]
     fn invalid_values_name_the_option_and_its_range() {
-        let error = parse(&words("--thread-position-mm 60")).unwrap_err();
-        assert!(error.0.contains("--thread-position-mm") && error.0.contains("30 to 45"));
-        let error = parse(&words("--excitation strum")).unwrap_err();
-        assert!(error.0.contains("pluck, first-mode"));
-        let error = parse(&words("--thread off --bridge off-beyond-thread")).unwrap_err();
-        assert!(error.0.contains("--thread on"));
-        assert!(parse(&words("--seconds 0")).is_err());
+        let error = parse("--thread-position-mm 60").unwrap_err();
+        assert!(
+            error.contains("--thread-position-mm") && error.contains("30 to 45"),
+            "{error}"
+        );
+        let error = parse("--excitation strum").unwrap_err();
+        assert!(error.contains("pluck, first-mode"), "{error}");
+        let error = parse("--thread off --bridge off-beyond-thread").unwrap_err();
+        assert!(error.contains("--thread on"), "{error}");
+        assert!(parse("--seconds 0").is_err());
+        let error = parse("--sekonds 2").unwrap_err();
+        assert!(error.contains("--sekonds"), "{error}");
     }
 
     #[test]
@@ -230,7 +267,8 @@ mod tests {
         std::fs::create_dir_all(&directory).unwrap();
         let csv = directory.join("probe.csv");
         let wav = directory.join("probe.wav");
-        let raw = vec![
+        let args = SimulateArgs::try_parse_from([
+            "simulate".to_string(),
             "--seconds".to_string(),
             "0.002".to_string(),
             "--every".to_string(),
@@ -239,8 +277,9 @@ mod tests {
             csv.display().to_string(),
             "--wav".to_string(),
             wav.display().to_string(),
-        ];
-        run(&raw).unwrap();
+        ])
+        .unwrap();
+        run(args).unwrap();
         let text = std::fs::read_to_string(&csv).unwrap();
         let mut lines = text.lines();
         assert_eq!(

@@ -19,8 +19,9 @@
 //! the Helmholtz value. `--sigma` selects the three-tap rounded corner of eq. 22 (compact only);
 //! α is then ζ/(1 − λ − 2σ) and `null` for a lossless pulse (λ + 2σ = 1, eq. 23).
 
-use crate::args::{ArgError, Args};
+use crate::args::{number_in, number_where};
 use crate::plot::{self, AxisScale, LinePlot, Series, SeriesStyle, PALETTE};
+use clap::{Parser, ValueEnum};
 use javari_core::engine::bowed_stability::bowed_stability;
 use javari_core::engine::preset::Preset as EnginePreset;
 use javari_core::engine::{BowedStringKind, Instrument};
@@ -29,15 +30,10 @@ use javari_core::stability::{
     ReflectionFunction, SpaceTimeModel, StabilityMargin, ThresholdOutcome, ThresholdSearch,
     TransferModel,
 };
+use rayon::prelude::*;
 use std::error::Error;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-const USAGE: &str = "usage:
-  cargo xtask stability --p P --q Q --lambda L --gamma G [--sigma S] [--slip N] [--zeta Z]
-                        [--formulation spacetime|compact] [--json]
-  cargo xtask stability --sweep fig7|fig8|fig13|fig10 [--csv FILE] [--png FILE]
-  cargo xtask stability --preset FILE [--json]";
 
 /// Largest p or q accepted: the space-time matrix has 2(p + q) rows.
 const MAX_SEGMENTS: usize = 500;
@@ -45,9 +41,12 @@ const MAX_SEGMENTS: usize = 500;
 /// The termination reflection of Figs. 7, 8, 10 and 13 (section 2.4).
 const SWEEP_LAMBDA: f64 = 0.9995;
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, ValueEnum)]
 enum Formulation {
+    /// Eq. 14–16: one state per segment, Raman's model only.
+    #[value(name = "spacetime")]
     SpaceTime,
+    /// Eq. 21–22: half the size, also the three-tap rounded corner.
     Compact,
 }
 
@@ -64,7 +63,7 @@ struct CaseOptions {
     json: bool,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, ValueEnum)]
 enum Figure {
     Fig7,
     Fig8,
@@ -86,89 +85,126 @@ enum Command {
     },
 }
 
-pub fn run(raw: &[String]) -> Result<(), Box<dyn Error>> {
-    let command = parse(raw)?;
+/// The options of a single case, which `--sweep` and `--preset` replace.
+const CASE_OPTIONS: [&str; 8] = [
+    "p",
+    "q",
+    "lambda",
+    "gamma",
+    "sigma",
+    "slip",
+    "zeta",
+    "formulation",
+];
+
+/// One case: `--p P --q Q --lambda L --gamma G [--sigma S] [--slip N] [--zeta Z]
+/// [--formulation spacetime|compact] [--json]`; a sweep: `--sweep FIG [--csv FILE] [--png FILE]`;
+/// a preset's margin: `--preset FILE [--json]`.
+#[derive(Debug, Parser)]
+pub struct StabilityArgs {
+    /// Bridge-side segments (1 to 500).
+    #[arg(long, value_name = "P", required_unless_present_any = ["sweep", "preset"],
+          value_parser = number_in(1usize, MAX_SEGMENTS))]
+    p: Option<usize>,
+    /// Finger-side segments (1 to 500).
+    #[arg(long, value_name = "Q", required_unless_present_any = ["sweep", "preset"],
+          value_parser = number_in(1usize, MAX_SEGMENTS))]
+    q: Option<usize>,
+    /// Termination reflection magnitude (0 < lambda <= 1).
+    #[arg(long, value_name = "L", required_unless_present_any = ["sweep", "preset"],
+          value_parser = number_where(|value| value > 0.0 && value <= 1.0, "a number above 0 and up to 1"))]
+    lambda: Option<f64>,
+    /// Sticking reflection magnitude (0 to 1).
+    #[arg(long, value_name = "G", required_unless_present_any = ["sweep", "preset"],
+          value_parser = number_in(0.0, 1.0))]
+    gamma: Option<f64>,
+    /// Side taps of the three-tap rounded corner of eq. 22 (0 to 1; compact only).
+    #[arg(long, value_name = "S", value_parser = number_in(0.0, 1.0))]
+    sigma: Option<f64>,
+    /// Slipping steps per period in the formulation's own step (default: Helmholtz).
+    #[arg(long, value_name = "N")]
+    slip: Option<usize>,
+    /// Where the eigenvalues are evaluated (-1 to 1e6; default: at the threshold).
+    #[arg(long, value_name = "Z", value_parser = number_in(-1.0, 1e6))]
+    zeta: Option<f64>,
+    /// State-vector formulation.
+    #[arg(long, value_enum, default_value_t = Formulation::Compact)]
+    formulation: Formulation,
+    /// Print one JSON object (a case) or array (an instrument preset).
+    #[arg(long, conflicts_with = "sweep")]
+    json: bool,
+    /// Recompute one of the paper's threshold figures.
+    #[arg(long, value_enum, value_name = "FIG", conflicts_with_all = CASE_OPTIONS)]
+    sweep: Option<Figure>,
+    /// Write the sweep as CSV (else it is printed).
+    #[arg(long, value_name = "FILE")]
+    csv: Option<PathBuf>,
+    /// Plot the sweep as PNG.
+    #[arg(long, value_name = "FILE")]
+    png: Option<PathBuf>,
+    /// Margin of a bowed setting: an analysis-grid file or presets/bowed-*.toml.
+    #[arg(long, value_name = "FILE", conflicts_with_all = CASE_OPTIONS, conflicts_with = "sweep")]
+    preset: Option<PathBuf>,
+}
+
+pub fn run(args: StabilityArgs) -> Result<(), Box<dyn Error>> {
+    let command = command(args).unwrap_or_else(|message| {
+        crate::usage_error("stability", message).exit();
+    });
     print!("{}", execute(&command)?);
     Ok(())
 }
 
-fn required<T>(args: &mut Args, name: &str, min: T, max: T) -> Result<T, ArgError>
-where
-    T: std::str::FromStr + PartialOrd + Copy + std::fmt::Display,
-{
-    if args.text(name).is_none() {
-        return Err(ArgError(format!(
-            "option `--{name}` is required (a number from {min} to {max})\n{USAGE}"
-        )));
-    }
-    args.number(name, min, min, max)
-}
-
-fn optional<T>(args: &mut Args, name: &str, min: T, max: T) -> Result<Option<T>, ArgError>
-where
-    T: std::str::FromStr + PartialOrd + Copy + std::fmt::Display,
-{
-    if args.text(name).is_none() {
-        return Ok(None);
-    }
-    args.number(name, min, min, max).map(Some)
-}
-
-fn parse(raw: &[String]) -> Result<Command, ArgError> {
-    let mut args = Args::parse(raw, &["json"])?;
-    let json = args.flag("json");
-    if args.text("sweep").is_some() {
-        let figure = match args.choice("sweep", "fig7", &["fig7", "fig8", "fig13", "fig10"])? {
-            "fig7" => Figure::Fig7,
-            "fig8" => Figure::Fig8,
-            "fig13" => Figure::Fig13,
-            _ => Figure::Fig10,
-        };
-        let csv = args.text("csv").map(PathBuf::from);
-        let png = args.text("png").map(PathBuf::from);
-        args.finish()?;
-        return Ok(Command::Sweep { figure, csv, png });
-    }
-    if let Some(path) = args.text("preset") {
-        args.finish()?;
-        return Ok(Command::Preset {
-            path: PathBuf::from(path),
-            json,
+/// What to compute, or why the options do not fit together.
+fn command(args: StabilityArgs) -> Result<Command, String> {
+    if let Some(figure) = args.sweep {
+        return Ok(Command::Sweep {
+            figure,
+            csv: args.csv,
+            png: args.png,
         });
     }
-    let p = required(&mut args, "p", 1, MAX_SEGMENTS)?;
-    let q = required(&mut args, "q", 1, MAX_SEGMENTS)?;
-    let lambda = required(&mut args, "lambda", f64::MIN_POSITIVE, 1.0)?;
-    let gamma = required(&mut args, "gamma", 0.0, 1.0)?;
-    let sigma = optional(&mut args, "sigma", 0.0, 1.0)?;
-    let default_formulation = "compact";
-    let formulation = match args.choice(
-        "formulation",
-        default_formulation,
-        &["spacetime", "compact"],
-    )? {
-        "spacetime" => Formulation::SpaceTime,
-        _ => Formulation::Compact,
+    // (clap's `requires` would be waived here: `--sweep` conflicts with the case options.)
+    if args.csv.is_some() || args.png.is_some() {
+        let option = if args.csv.is_some() { "--csv" } else { "--png" };
+        return Err(format!(
+            "option `{option}` writes a sweep: it needs `--sweep`"
+        ));
+    }
+    if let Some(path) = args.preset {
+        return Ok(Command::Preset {
+            path,
+            json: args.json,
+        });
+    }
+    // clap has checked that these are present when there is neither a sweep nor a preset.
+    let (Some(p), Some(q), Some(lambda), Some(gamma)) = (args.p, args.q, args.lambda, args.gamma)
+    else {
+        return Err("options `--p`, `--q`, `--lambda` and `--gamma` are required".into());
     };
+    let formulation = args.formulation;
     let period = match formulation {
         Formulation::SpaceTime => 2 * (p + q),
         Formulation::Compact => p + q,
     };
-    let slip = optional(&mut args, "slip", 0, period)?;
-    let zeta = optional(&mut args, "zeta", -1.0, 1e6)?;
-    args.finish()?;
+    if let Some(slip) = args.slip.filter(|&slip| slip > period) {
+        return Err(format!(
+            "option `--slip`: {slip} is out of range, expected a number from 0 to {period}"
+        ));
+    }
+    let sigma = args.sigma;
     if sigma.is_some() && formulation == Formulation::SpaceTime {
-        return Err(ArgError(
+        return Err(
             "option `--sigma`: the three-tap reflection function needs `--formulation compact` \
              (the space-time formulation is Raman's model only)"
                 .into(),
-        ));
+        );
     }
     if sigma.is_some() && p < 2 {
-        return Err(ArgError(format!(
+        return Err(format!(
             "option `--p`: {p} is out of range, the three-tap reflection function (--sigma) needs \
              p of at least 2"
-        )));
+        ));
     }
     Ok(Command::Case(CaseOptions {
         p,
@@ -176,10 +212,10 @@ fn parse(raw: &[String]) -> Result<Command, ArgError> {
         lambda,
         gamma,
         sigma,
-        slip,
-        zeta,
+        slip: args.slip,
+        zeta: args.zeta,
         formulation,
-        json,
+        json: args.json,
     }))
 }
 
@@ -435,60 +471,66 @@ struct SweepRow {
 
 fn sweep_rows(figure: Figure) -> Result<Vec<SweepRow>, Box<dyn Error>> {
     let search = ThresholdSearch::default();
-    let mut rows = Vec::new();
-    let mut push = |p, q, slip_steps, formulation, outcome: ThresholdOutcome| {
-        let threshold = outcome.crossing();
-        rows.push(SweepRow {
-            p,
-            q,
-            slip_steps,
-            formulation,
-            zeta_c: threshold.map_or(f64::NAN, |threshold| threshold.zeta),
-            order: threshold.map(|threshold| threshold.critical.subharmonic_order),
-        });
+    // (p, q, slipping steps) of every case of the figure.
+    let cases: Vec<(usize, usize, usize)> = match figure {
+        Figure::Fig7 | Figure::Fig8 | Figure::Fig13 => (1..=10)
+            .flat_map(|p| (p..=20).map(move |q| (p, q, p)))
+            .collect(),
+        Figure::Fig10 => [(3, 16), (4, 15), (5, 14), (6, 13), (7, 12)]
+            .into_iter()
+            .flat_map(|(p, q)| (1..=30).map(move |slip| (p, q, slip)))
+            .collect(),
     };
-    match figure {
+    // The cases are independent: rayon spreads them over the cores; `collect` keeps their order.
+    let rows: Result<Vec<SweepRow>, String> = cases
+        .par_iter()
+        .map(|&(p, q, slip)| {
+            sweep_case(&search, figure, p, q, slip)
+                .map_err(|error| format!("p = {p}, q = {q}, slip = {slip}: {error}"))
+        })
+        .collect();
+    Ok(rows?)
+}
+
+/// One case of a sweep: its threshold by the formulation the figure uses.
+fn sweep_case(
+    search: &ThresholdSearch,
+    figure: Figure,
+    p: usize,
+    q: usize,
+    slip_steps: usize,
+) -> Result<SweepRow, Box<dyn Error>> {
+    let (formulation, outcome) = match figure {
         Figure::Fig7 | Figure::Fig13 => {
             let gamma = if figure == Figure::Fig7 { 1.0 } else { 0.9 };
-            for p in 1..=10 {
-                for q in p..=20 {
-                    // The compact formulation: the same spectrum as eq. 15, half the size.
-                    let motion = PeriodicMotion::new(
-                        CompactModel::raman(p, q, SWEEP_LAMBDA)?,
-                        ContactPattern::helmholtz_compact(p, q)?,
-                        gamma,
-                    )?;
-                    push(p, q, p, Formulation::Compact, search.run(&motion)?);
-                }
-            }
+            // The compact formulation: the same spectrum as eq. 15, half the size.
+            let motion = PeriodicMotion::new(
+                CompactModel::raman(p, q, SWEEP_LAMBDA)?,
+                ContactPattern::helmholtz_compact(p, q)?,
+                gamma,
+            )?;
+            (Formulation::Compact, search.run(&motion)?)
         }
-        Figure::Fig8 => {
-            for p in 1..=10 {
-                for q in p..=20 {
-                    // Eq. 16: M₁^p M₂^{2q+p}, an odd slip count needs the space-time form.
-                    let motion = PeriodicMotion::new(
-                        SpaceTimeModel::new(p, q, SWEEP_LAMBDA)?,
-                        ContactPattern::single_slip(2 * (p + q), p)?,
-                        1.0,
-                    )?;
-                    push(p, q, p, Formulation::SpaceTime, search.run(&motion)?);
-                }
-            }
+        // Fig. 8 — eq. 16: M₁^p M₂^{2q+p}, an odd slip count needs the space-time form — and
+        // Fig. 10, the slip time swept.
+        Figure::Fig8 | Figure::Fig10 => {
+            let motion = PeriodicMotion::new(
+                SpaceTimeModel::new(p, q, SWEEP_LAMBDA)?,
+                ContactPattern::single_slip(2 * (p + q), slip_steps)?,
+                1.0,
+            )?;
+            (Formulation::SpaceTime, search.run(&motion)?)
         }
-        Figure::Fig10 => {
-            for (p, q) in [(3, 16), (4, 15), (5, 14), (6, 13), (7, 12)] {
-                for slip in 1..=30 {
-                    let motion = PeriodicMotion::new(
-                        SpaceTimeModel::new(p, q, SWEEP_LAMBDA)?,
-                        ContactPattern::single_slip(2 * (p + q), slip)?,
-                        1.0,
-                    )?;
-                    push(p, q, slip, Formulation::SpaceTime, search.run(&motion)?);
-                }
-            }
-        }
-    }
-    Ok(rows)
+    };
+    let threshold = outcome.crossing();
+    Ok(SweepRow {
+        p,
+        q,
+        slip_steps,
+        formulation,
+        zeta_c: threshold.map_or(f64::NAN, |threshold| threshold.zeta),
+        order: threshold.map(|threshold| threshold.critical.subharmonic_order),
+    })
 }
 
 fn sweep_csv(rows: &[SweepRow]) -> String {
@@ -819,18 +861,26 @@ fn margin_text(setting: &BowedSetting, margin: &StabilityMargin) -> String {
 mod tests {
     use super::*;
 
-    fn words(text: &str) -> Vec<String> {
-        text.split_whitespace().map(str::to_string).collect()
+    /// The command of a command line, or the error clap or the checks would print.
+    fn parse(line: &str) -> Result<Command, String> {
+        let words = std::iter::once("stability").chain(line.split_whitespace());
+        let args = StabilityArgs::try_parse_from(words).map_err(|error| error.to_string())?;
+        command(args)
     }
 
     fn error_of(text: &str) -> String {
-        parse(&words(text)).unwrap_err().0
+        parse(text).unwrap_err()
     }
 
     #[test]
     fn missing_required_option_is_named() {
         let error = error_of("--q 3 --lambda 0.99 --gamma 1");
-        assert!(error.contains("`--p` is required"), "{error}");
+        assert!(
+            error.contains("required") && error.contains("--p <P>"),
+            "{error}"
+        );
+        assert!(parse("--sweep fig7").is_ok());
+        assert!(parse("--preset x.toml --json").is_ok());
     }
 
     #[test]
@@ -865,15 +915,18 @@ mod tests {
             "{error}"
         );
         let error = error_of("--p 2 --q 3 --lambda 0.9 --gamma 1 --zeta-c 3");
-        assert!(error.contains("unknown option `--zeta-c`"), "{error}");
+        assert!(error.contains("--zeta-c"), "{error}");
+        let error = error_of("--sweep fig7 --p 3");
+        assert!(error.contains("--p"), "{error}");
+        let error = error_of("--p 2 --q 3 --lambda 0.9 --gamma 1 --csv out.csv");
+        assert!(error.contains("--sweep"), "{error}");
     }
 
     #[test]
     fn table_i_as_json() {
-        let command = parse(&words(
-            "--p 2 --q 3 --lambda 0.99 --gamma 1 --zeta 0.01 --formulation spacetime --json",
-        ))
-        .unwrap();
+        let command =
+            parse("--p 2 --q 3 --lambda 0.99 --gamma 1 --zeta 0.01 --formulation spacetime --json")
+                .unwrap();
         let output = execute(&command).unwrap();
         assert_eq!(output.lines().count(), 1);
         assert!(output.starts_with("{\"zeta_c\": 0.0122070079"), "{output}");

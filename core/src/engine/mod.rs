@@ -194,6 +194,56 @@ struct Slot {
     level: f32,
 }
 
+/// Runs `slot`'s voice for `length` samples, handing each scaled sample to `emit(index, value)`,
+/// and updates the slot's level. A voice that blows up is silenced and emits nothing more.
+fn run_slot(slot: &mut Slot, release: f32, length: usize, mut emit: impl FnMut(usize, f32)) {
+    if !slot.voice.is_active() {
+        slot.level = 0.0;
+        return;
+    }
+    let scale = (slot.level_factor / NEWTONS_AT_FULL_SCALE) as f32;
+    let mut level = slot.level;
+    for index in 0..length {
+        let value = slot.voice.next_sample() * scale;
+        if !value.is_finite() {
+            // Fail soft: a voice that blew up is silenced, never passed on.
+            slot.voice.reset();
+            level = 0.0;
+            break;
+        }
+        emit(index, value);
+        level = value.abs().max(level * release);
+    }
+    slot.level = level;
+}
+
+/// One sounding voice's share of a segment in [`Engine::process_with`]; [`VoiceTask::run`] may be
+/// called on any thread, and each task touches only its own voice and buffer.
+pub struct VoiceTask<'a> {
+    slot: &'a mut Slot,
+    release: f32,
+    samples: &'a mut [f32],
+    /// Samples produced: all of them, or fewer when the voice blew up and was silenced.
+    written: usize,
+}
+
+impl VoiceTask<'_> {
+    /// Computes this voice's samples for the segment.
+    pub fn run(&mut self) {
+        let samples = &mut *self.samples;
+        let mut written = 0;
+        run_slot(self.slot, self.release, samples.len(), |index, value| {
+            samples[index] = value;
+            written = index + 1;
+        });
+        self.written = written;
+    }
+}
+
+/// Runs every task of a segment once, in any order and on any threads (e.g.
+/// `|tasks| tasks.par_iter_mut().for_each(VoiceTask::run)` with rayon).
+pub type VoiceRunner<'r> = &'r (dyn Fn(&mut [VoiceTask<'_>]) + Sync);
+
 /// The tension, and with it the force at the nut and bridge for a given displacement, grows
 /// with the square of the pitch. So that a pluck sounds equally loud on any note, each string's
 /// force is multiplied by `(f_ref / f)²`.
@@ -226,6 +276,8 @@ pub struct Engine {
     bowed: Vec<BowedInstrument>,
     /// The bow controls last applied from the settings (knobs), to apply only their changes.
     applied_bow_controls: Option<(f64, f64, f64)>,
+    /// One buffer per voice for [`Engine::process_with`] (empty until it is used).
+    scratch: Vec<Vec<f32>>,
 }
 
 /// `ln(1 + k_b)`: stiffness ramps in a logarithmic domain (its range spans twelve decades) that
@@ -290,6 +342,7 @@ impl Engine {
                 })
                 .collect(),
             applied_bow_controls: None,
+            scratch: Vec::new(),
         };
         engine.target.voice = voice;
         engine.apply_bowed_settings();
@@ -453,6 +506,28 @@ impl Engine {
     /// offsets. Events must be sorted by offset; an offset past the block is applied at its last
     /// sample. Allocation-free, never panics.
     pub fn process(&mut self, events: &[TimedEvent], output: &mut [f32]) {
+        self.process_inner(events, output, None);
+    }
+
+    /// [`Engine::process`] with the voices of each segment run by `runner` (offline rendering
+    /// on a thread pool): the output is bit-identical to [`Engine::process`]'s whatever order or
+    /// threads `runner` runs the tasks in. Allocates (per-voice buffers and the task list), so
+    /// it is not for the audio thread.
+    pub fn process_with(
+        &mut self,
+        events: &[TimedEvent],
+        output: &mut [f32],
+        runner: VoiceRunner<'_>,
+    ) {
+        self.process_inner(events, output, Some(runner));
+    }
+
+    fn process_inner(
+        &mut self,
+        events: &[TimedEvent],
+        output: &mut [f32],
+        runner: Option<VoiceRunner<'_>>,
+    ) {
         output.fill(0.0);
         let length = output.len();
         let mut position = 0;
@@ -481,13 +556,13 @@ impl Engine {
                 end = end.min(position + until.min(length as u64) as usize);
             }
             let end = end.max(position + 1);
-            self.render_segment(&mut output[position..end]);
+            self.render_segment(&mut output[position..end], runner);
             self.clock += (end - position) as u64;
             position = end;
         }
     }
 
-    fn render_segment(&mut self, output: &mut [f32]) {
+    fn render_segment(&mut self, output: &mut [f32], runner: Option<VoiceRunner<'_>>) {
         if self.target.instrument == Instrument::Bowed {
             let scale = 1.0 / BOWED_NEWTONS_AT_FULL_SCALE;
             let bowed = self.bowed_mut();
@@ -496,25 +571,45 @@ impl Engine {
             }
         }
         let release = self.level_release;
-        for slot in &mut self.slots {
-            if !slot.voice.is_active() {
-                slot.level = 0.0;
-                continue;
-            }
-            let scale = (slot.level_factor / NEWTONS_AT_FULL_SCALE) as f32;
-            let mut level = slot.level;
-            for sample in output.iter_mut() {
-                let value = slot.voice.next_sample() * scale;
-                if !value.is_finite() {
-                    // Fail soft: a voice that blew up is silenced, never passed on.
-                    slot.voice.reset();
-                    level = 0.0;
-                    break;
+        match runner {
+            // The audio thread: each voice adds into the output in turn.
+            None => {
+                for slot in &mut self.slots {
+                    run_slot(slot, release, output.len(), |index, value| {
+                        output[index] += value
+                    });
                 }
-                *sample += value;
-                level = value.abs().max(level * release);
             }
-            slot.level = level;
+            // Offline: each active voice fills its own buffer, on whatever thread the runner
+            // picks; the buffers are then added in slot order, so that the sum (and its
+            // rounding) is the same as above.
+            Some(runner) => {
+                self.scratch.resize_with(self.slots.len(), Vec::new);
+                let mut tasks: Vec<VoiceTask<'_>> = self
+                    .slots
+                    .iter_mut()
+                    .zip(&mut self.scratch)
+                    .filter_map(|(slot, samples)| {
+                        if !slot.voice.is_active() {
+                            slot.level = 0.0;
+                            return None;
+                        }
+                        samples.resize(output.len(), 0.0);
+                        Some(VoiceTask {
+                            slot,
+                            release,
+                            samples,
+                            written: 0,
+                        })
+                    })
+                    .collect();
+                runner(&mut tasks);
+                for task in &tasks {
+                    for (sample, value) in output.iter_mut().zip(&task.samples[..task.written]) {
+                        *sample += *value;
+                    }
+                }
+            }
         }
         for sample in output.iter_mut() {
             *sample *= self.output_gain.step() as f32;

@@ -1,9 +1,12 @@
-//! Presets: a readable `key = value` file (a subset of TOML) mapped onto [`EngineSettings`].
+//! Presets: a readable TOML file of top-level `key = value` lines mapped onto
+//! [`EngineSettings`]. The `toml` crate reads it through serde ([`PresetFile`]); this module adds
+//! the ranges and the error messages.
 //!
-//! Every key names its unit. Lines are `key = value`; `#` starts a comment; strings are quoted
-//! ("classic"), switches are `true`/`false`. A key left out keeps its default, so an old preset
-//! keeps loading when keys are added; an unknown key, a value of the wrong kind or out of range is
-//! an error naming the file, the line, the key and what was expected.
+//! Every key names its unit. `#` starts a comment; strings are quoted ("classic"), switches are
+//! `true`/`false`, numbers may be written as integers. A key left out keeps its default, so an old
+//! preset keeps loading when keys are added; an unknown key, a value of the wrong kind or out of
+//! range, a repeated key or a line that is not TOML is an error naming the file, the line, the key
+//! and what was expected (the parser's byte spans are turned into line numbers).
 //!
 //! | key | unit | range | meaning |
 //! |---|---|---|---|
@@ -41,8 +44,11 @@ use crate::tanpura::excitation::Pluck;
 use crate::tanpura::geometry::ThreadSettings;
 use crate::tanpura::quality::Quality;
 use crate::tanpura::{FirstString, VoiceSettings};
+use serde::{Deserialize, Serialize};
 use std::fmt;
+use std::ops::Range;
 use std::path::Path;
+use toml::Spanned;
 
 /// Range of the pluck position, m from the tuning bead: past the bridge and thread, short of the
 /// nut (string length 0.668 m).
@@ -101,6 +107,228 @@ impl fmt::Display for PresetError {
 
 impl std::error::Error for PresetError {}
 
+/// What a key's value must be.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    Text,
+    Switch,
+    /// A number within an inclusive range.
+    Number((f64, f64)),
+    /// One of a few quoted words.
+    Choice(&'static [&'static str]),
+}
+
+impl Kind {
+    fn expected(self) -> String {
+        match self {
+            Kind::Text => "a quoted string".to_string(),
+            Kind::Switch => "true or false".to_string(),
+            Kind::Number((min, max)) => format!("a number from {min} to {max}"),
+            Kind::Choice(choices) => format!("one of \"{}\"", choices.join("\", \"")),
+        }
+    }
+}
+
+/// Every key and what it takes, in the order of [`PresetFile`] and of the table above.
+const KEYS: [(&str, Kind); 26] = [
+    ("name", Kind::Text),
+    (
+        "bridge_stiffness_n_m2",
+        Kind::Number(VoiceSettings::BRIDGE_STIFFNESS_RANGE),
+    ),
+    ("thread_enabled", Kind::Switch),
+    (
+        "thread_position_m",
+        Kind::Number(ThreadSettings::POSITION_RANGE_M),
+    ),
+    ("bridge_beyond_thread", Kind::Switch),
+    ("gamma_per_s", Kind::Number(VoiceSettings::GAMMA_RANGE)),
+    ("eta_s", Kind::Number(VoiceSettings::ETA_RANGE)),
+    ("nut_pickup_weight", Kind::Number((0.0, 1.0))),
+    ("quality", Kind::Choice(&QUALITY_NAMES)),
+    ("pluck_position_m", Kind::Number(PLUCK_POSITION_RANGE_M)),
+    ("pluck_width_m", Kind::Number(Pluck::WIDTH_RANGE_M)),
+    ("pluck_amplitude_m", Kind::Number(Pluck::AMPLITUDE_RANGE_M)),
+    ("output_gain_db", Kind::Number(OUTPUT_GAIN_RANGE_DB)),
+    ("drone_enabled", Kind::Switch),
+    ("drone_first_string", Kind::Choice(&FIRST_STRING_NAMES)),
+    ("drone_tempo_sync", Kind::Switch),
+    ("drone_tempo_bpm", Kind::Number(TEMPO_RANGE_BPM)),
+    ("instrument", Kind::Choice(&INSTRUMENT_NAMES)),
+    ("bow_model", Kind::Choice(&BOW_MODEL_NAMES)),
+    ("bow_string", Kind::Choice(&BOW_STRING_NAMES)),
+    ("bow_pressure", Kind::Number((0.0, 1.0))),
+    ("bow_velocity_m_s", Kind::Number(BOW_VELOCITY_RANGE_M_S)),
+    ("bow_position", Kind::Number(BOW_POSITION_RANGE)),
+    ("bow_glide_s", Kind::Number((0.0, 1.0))),
+    ("bow_vibrato_cents", Kind::Number((0.0, 100.0))),
+    ("bow_body", Kind::Switch),
+];
+
+fn kind_of(key: &str) -> Option<Kind> {
+    KEYS.iter()
+        .find(|(name, _)| *name == key)
+        .map(|(_, kind)| *kind)
+}
+
+/// A preset file as TOML and serde read it: every key optional, each value with its byte span
+/// in the text so that a range error can name its line. (The spans are ignored when writing.)
+#[derive(Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+struct PresetFile {
+    name: Option<Spanned<String>>,
+    bridge_stiffness_n_m2: Option<Spanned<f64>>,
+    thread_enabled: Option<Spanned<bool>>,
+    thread_position_m: Option<Spanned<f64>>,
+    bridge_beyond_thread: Option<Spanned<bool>>,
+    gamma_per_s: Option<Spanned<f64>>,
+    eta_s: Option<Spanned<f64>>,
+    nut_pickup_weight: Option<Spanned<f64>>,
+    quality: Option<Spanned<String>>,
+    pluck_position_m: Option<Spanned<f64>>,
+    pluck_width_m: Option<Spanned<f64>>,
+    pluck_amplitude_m: Option<Spanned<f64>>,
+    output_gain_db: Option<Spanned<f64>>,
+    drone_enabled: Option<Spanned<bool>>,
+    drone_first_string: Option<Spanned<String>>,
+    drone_tempo_sync: Option<Spanned<bool>>,
+    drone_tempo_bpm: Option<Spanned<f64>>,
+    instrument: Option<Spanned<String>>,
+    bow_model: Option<Spanned<String>>,
+    bow_string: Option<Spanned<String>>,
+    bow_pressure: Option<Spanned<f64>>,
+    bow_velocity_m_s: Option<Spanned<f64>>,
+    bow_position: Option<Spanned<f64>>,
+    bow_glide_s: Option<Spanned<f64>>,
+    bow_vibrato_cents: Option<Spanned<f64>>,
+    bow_body: Option<Spanned<bool>>,
+}
+
+/// The 1-based line of byte `offset` in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&byte| byte == b'\n')
+        .count()
+        + 1
+}
+
+/// Removes a `#` comment that is not inside a quoted string (for quoting a line in an error).
+fn strip_comment(line: &str) -> &str {
+    let mut in_string = false;
+    for (index, character) in line.char_indices() {
+        match character {
+            '"' => in_string = !in_string,
+            '#' if !in_string => return &line[..index],
+            _ => {}
+        }
+    }
+    line
+}
+
+/// Reads the values of a parsed [`PresetFile`], checking each against its [`Kind`].
+struct Checker<'a> {
+    text: &'a str,
+    file: &'a str,
+}
+
+impl Checker<'_> {
+    fn error(&self, line: usize, field: &str, expected: String) -> PresetError {
+        PresetError {
+            file: self.file.to_string(),
+            line,
+            field: field.to_string(),
+            expected,
+        }
+    }
+
+    /// The value at `span` is not what `key` takes.
+    fn fail(&self, key: &str, span: Range<usize>) -> PresetError {
+        let kind = kind_of(key).expect("every field of PresetFile is in KEYS");
+        let found = self.text.get(span.clone()).unwrap_or("").trim();
+        self.error(
+            line_of(self.text, span.start),
+            key,
+            format!("{}, found `{found}`", kind.expected()),
+        )
+    }
+
+    fn number(&self, key: &str, value: Option<Spanned<f64>>) -> Result<Option<f64>, PresetError> {
+        let Some(value) = value else { return Ok(None) };
+        let Some(Kind::Number((min, max))) = kind_of(key) else {
+            unreachable!("`{key}` is a number in KEYS")
+        };
+        let number = *value.get_ref();
+        // `!(a <= b)` rather than `a > b` so that a NaN is rejected too.
+        if !(min <= number && number <= max) {
+            return Err(self.fail(key, value.span()));
+        }
+        Ok(Some(number))
+    }
+
+    fn choice(
+        &self,
+        key: &str,
+        value: Option<Spanned<String>>,
+    ) -> Result<Option<&'static str>, PresetError> {
+        let Some(value) = value else { return Ok(None) };
+        let Some(Kind::Choice(choices)) = kind_of(key) else {
+            unreachable!("`{key}` is a choice in KEYS")
+        };
+        choices
+            .iter()
+            .copied()
+            .find(|choice| choice == value.get_ref())
+            .map(Some)
+            .ok_or_else(|| self.fail(key, value.span()))
+    }
+
+    /// The parser's own error, in the preset's terms: the line its span points at and, when
+    /// that line is `key = value` with a known key, what the key takes.
+    fn syntax(&self, error: &toml::de::Error) -> PresetError {
+        let message = error.message();
+        let span = error.span().unwrap_or(0..0);
+        let line = line_of(self.text, span.start);
+        // For a repeated or unknown key the span is the key itself.
+        let spanned_key = self
+            .text
+            .get(span)
+            .unwrap_or("")
+            .trim()
+            .trim_matches(['"', '\'']);
+        if message.starts_with("duplicate key") {
+            return self.error(line, spanned_key, "each key at most once".to_string());
+        }
+        if message.starts_with("unknown field") {
+            let known: Vec<&str> = KEYS.iter().map(|(name, _)| *name).collect();
+            return self.error(
+                line,
+                spanned_key,
+                format!("a known key, one of: {}", known.join(", ")),
+            );
+        }
+        let content = self
+            .text
+            .lines()
+            .nth(line - 1)
+            .map_or("", |line| strip_comment(line).trim());
+        match content.split_once('=') {
+            None => self.error(line, "", format!("a `key = value` line, found `{content}`")),
+            Some((key, value)) => {
+                let key = key.trim();
+                match kind_of(key) {
+                    Some(kind) => self.error(
+                        line,
+                        key,
+                        format!("{}, found `{}`", kind.expected(), value.trim()),
+                    ),
+                    None => self.error(line, key, message.trim().to_string()),
+                }
+            }
+        }
+    }
+}
+
 impl Preset {
     /// Reads and parses a preset file.
     pub fn load(path: &Path) -> Result<Self, PresetError> {
@@ -116,266 +344,164 @@ impl Preset {
 
     /// Parses preset text; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Self, PresetError> {
+        let check = Checker { text, file };
+        let read: PresetFile = toml::from_str(text).map_err(|error| check.syntax(&error))?;
         let mut preset = Preset {
-            name: String::from("unnamed"),
+            name: read
+                .name
+                .map_or_else(|| "unnamed".to_string(), Spanned::into_inner),
             settings: EngineSettings::default(),
         };
-        let mut seen: Vec<String> = Vec::new();
-        for (index, raw_line) in text.lines().enumerate() {
-            let line_number = index + 1;
-            let line = strip_comment(raw_line).trim();
-            if line.is_empty() {
-                continue;
+        let settings = &mut preset.settings;
+        let voice = &mut settings.voice;
+        let switch = |value: Option<Spanned<bool>>| value.map(Spanned::into_inner);
+        let set = |target: &mut f64, value: Option<f64>| {
+            if let Some(value) = value {
+                *target = value;
             }
-            let error = |field: &str, expected: String| PresetError {
-                file: file.to_string(),
-                line: line_number,
-                field: field.to_string(),
-                expected,
-            };
-            let Some((key, value)) = line.split_once('=') else {
-                return Err(error("", format!("a `key = value` line, found `{line}`")));
-            };
-            let key = key.trim();
-            let value = Value {
-                text: value.trim(),
-                key,
-                make_error: &error,
-            };
-            if seen.iter().any(|done| done == key) {
-                return Err(error(key, "each key at most once".to_string()));
+        };
+        let set_switch = |target: &mut bool, value: Option<bool>| {
+            if let Some(value) = value {
+                *target = value;
             }
-            seen.push(key.to_string());
-            let settings = &mut preset.settings;
-            match key {
-                "name" => preset.name = value.string()?.to_string(),
-                "bridge_stiffness_n_m2" => {
-                    settings.voice.bridge_stiffness_n_m2 =
-                        value.number(VoiceSettings::BRIDGE_STIFFNESS_RANGE)?
-                }
-                "thread_enabled" => settings.voice.thread_enabled = value.boolean()?,
-                "thread_position_m" => {
-                    settings.voice.thread_position_m =
-                        value.number(ThreadSettings::POSITION_RANGE_M)?
-                }
-                "bridge_beyond_thread" => settings.voice.bridge_beyond_thread = value.boolean()?,
-                "gamma_per_s" => {
-                    settings.voice.gamma_per_s = value.number(VoiceSettings::GAMMA_RANGE)?
-                }
-                "eta_s" => settings.voice.eta_s = value.number(VoiceSettings::ETA_RANGE)?,
-                "nut_pickup_weight" => {
-                    settings.voice.nut_pickup_weight = value.number((0.0, 1.0))?
-                }
-                "quality" => {
-                    let name = value.choice(&QUALITY_NAMES)?;
-                    settings.voice.quality =
-                        Quality::from_name(name).expect("choice() only returns listed names");
-                }
-                "pluck_position_m" => {
-                    settings.pluck.position_m = value.number(PLUCK_POSITION_RANGE_M)?
-                }
-                "pluck_width_m" => settings.pluck.width_m = value.number(Pluck::WIDTH_RANGE_M)?,
-                "pluck_amplitude_m" => {
-                    settings.pluck.amplitude_m = value.number(Pluck::AMPLITUDE_RANGE_M)?
-                }
-                "output_gain_db" => settings.output_gain_db = value.number(OUTPUT_GAIN_RANGE_DB)?,
-                "drone_enabled" => settings.drone.enabled = value.boolean()?,
-                "drone_first_string" => {
-                    settings.drone.first_string = match value.choice(&FIRST_STRING_NAMES)? {
-                        "ma" => FirstString::Ma,
-                        "ni" => FirstString::Ni,
-                        _ => FirstString::Pa,
-                    }
-                }
-                "drone_tempo_sync" => settings.drone.tempo_sync = value.boolean()?,
-                "drone_tempo_bpm" => {
-                    settings.drone.free_tempo_bpm = value.number(TEMPO_RANGE_BPM)?
-                }
-                "instrument" => {
-                    settings.instrument = match value.choice(&INSTRUMENT_NAMES)? {
-                        "bowed" => Instrument::Bowed,
-                        _ => Instrument::Tanpura,
-                    }
-                }
-                "bow_model" => {
-                    settings.bowed.player.tier = match value.choice(&BOW_MODEL_NAMES)? {
-                        "bow-table" => BowTier::BowTable,
-                        _ => BowTier::RoundedCorner,
-                    }
-                }
-                "bow_string" => {
-                    settings.bowed.string = match value.choice(&BOW_STRING_NAMES)? {
-                        "cello-d" => BowedStringKind::CelloD,
-                        _ => BowedStringKind::ViolinA,
-                    }
-                }
-                "bow_pressure" => settings.bowed.pressure = value.number((0.0, 1.0))?,
-                "bow_velocity_m_s" => {
-                    settings.bowed.bow_velocity_m_s = value.number(BOW_VELOCITY_RANGE_M_S)?
-                }
-                "bow_position" => settings.bowed.bow_position = value.number(BOW_POSITION_RANGE)?,
-                "bow_glide_s" => settings.bowed.player.glide_time_s = value.number((0.0, 1.0))?,
-                "bow_vibrato_cents" => {
-                    settings.bowed.player.max_vibrato_cents = value.number((0.0, 100.0))?
-                }
-                "bow_body" => settings.bowed.player.body_enabled = value.boolean()?,
-                _ => {
-                    return Err(error(
-                        key,
-                        format!("a known key, one of: {}", KNOWN_KEYS.join(", ")),
-                    ))
-                }
-            }
+        };
+
+        set(
+            &mut voice.bridge_stiffness_n_m2,
+            check.number("bridge_stiffness_n_m2", read.bridge_stiffness_n_m2)?,
+        );
+        set_switch(&mut voice.thread_enabled, switch(read.thread_enabled));
+        set(
+            &mut voice.thread_position_m,
+            check.number("thread_position_m", read.thread_position_m)?,
+        );
+        set_switch(
+            &mut voice.bridge_beyond_thread,
+            switch(read.bridge_beyond_thread),
+        );
+        set(
+            &mut voice.gamma_per_s,
+            check.number("gamma_per_s", read.gamma_per_s)?,
+        );
+        set(&mut voice.eta_s, check.number("eta_s", read.eta_s)?);
+        set(
+            &mut voice.nut_pickup_weight,
+            check.number("nut_pickup_weight", read.nut_pickup_weight)?,
+        );
+        if let Some(name) = check.choice("quality", read.quality)? {
+            voice.quality = Quality::from_name(name).expect("QUALITY_NAMES are the tiers' names");
         }
+        set(
+            &mut settings.pluck.position_m,
+            check.number("pluck_position_m", read.pluck_position_m)?,
+        );
+        set(
+            &mut settings.pluck.width_m,
+            check.number("pluck_width_m", read.pluck_width_m)?,
+        );
+        set(
+            &mut settings.pluck.amplitude_m,
+            check.number("pluck_amplitude_m", read.pluck_amplitude_m)?,
+        );
+        set(
+            &mut settings.output_gain_db,
+            check.number("output_gain_db", read.output_gain_db)?,
+        );
+        set_switch(&mut settings.drone.enabled, switch(read.drone_enabled));
+        if let Some(first) = check.choice("drone_first_string", read.drone_first_string)? {
+            settings.drone.first_string = match first {
+                "ma" => FirstString::Ma,
+                "ni" => FirstString::Ni,
+                _ => FirstString::Pa,
+            };
+        }
+        set_switch(
+            &mut settings.drone.tempo_sync,
+            switch(read.drone_tempo_sync),
+        );
+        set(
+            &mut settings.drone.free_tempo_bpm,
+            check.number("drone_tempo_bpm", read.drone_tempo_bpm)?,
+        );
+        if let Some(instrument) = check.choice("instrument", read.instrument)? {
+            settings.instrument = match instrument {
+                "bowed" => Instrument::Bowed,
+                _ => Instrument::Tanpura,
+            };
+        }
+        let bowed = &mut settings.bowed;
+        if let Some(model) = check.choice("bow_model", read.bow_model)? {
+            bowed.player.tier = match model {
+                "bow-table" => BowTier::BowTable,
+                _ => BowTier::RoundedCorner,
+            };
+        }
+        if let Some(string) = check.choice("bow_string", read.bow_string)? {
+            bowed.string = match string {
+                "cello-d" => BowedStringKind::CelloD,
+                _ => BowedStringKind::ViolinA,
+            };
+        }
+        set(
+            &mut bowed.pressure,
+            check.number("bow_pressure", read.bow_pressure)?,
+        );
+        set(
+            &mut bowed.bow_velocity_m_s,
+            check.number("bow_velocity_m_s", read.bow_velocity_m_s)?,
+        );
+        set(
+            &mut bowed.bow_position,
+            check.number("bow_position", read.bow_position)?,
+        );
+        set(
+            &mut bowed.player.glide_time_s,
+            check.number("bow_glide_s", read.bow_glide_s)?,
+        );
+        set(
+            &mut bowed.player.max_vibrato_cents,
+            check.number("bow_vibrato_cents", read.bow_vibrato_cents)?,
+        );
+        set_switch(&mut bowed.player.body_enabled, switch(read.bow_body));
         Ok(preset)
     }
 
-    /// The preset as text that [`Preset::parse`] reads back to the same settings.
+    /// The preset as TOML text that [`Preset::parse`] reads back to the same settings (every
+    /// key, in the order of the table above).
     pub fn to_text(&self) -> String {
         let s = &self.settings;
         let v = &s.voice;
-        format!(
-            "name = \"{}\"\n\
-             bridge_stiffness_n_m2 = {:e}\n\
-             thread_enabled = {}\n\
-             thread_position_m = {}\n\
-             bridge_beyond_thread = {}\n\
-             gamma_per_s = {}\n\
-             eta_s = {:e}\n\
-             nut_pickup_weight = {}\n\
-             quality = \"{}\"\n\
-             pluck_position_m = {}\n\
-             pluck_width_m = {}\n\
-             pluck_amplitude_m = {}\n\
-             output_gain_db = {}\n\
-             drone_enabled = {}\n\
-             drone_first_string = \"{}\"\n\
-             drone_tempo_sync = {}\n\
-             drone_tempo_bpm = {}\n\
-             instrument = \"{}\"\n\
-             bow_model = \"{}\"\n\
-             bow_string = \"{}\"\n\
-             bow_pressure = {}\n\
-             bow_velocity_m_s = {}\n\
-             bow_position = {}\n\
-             bow_glide_s = {}\n\
-             bow_vibrato_cents = {}\n\
-             bow_body = {}\n",
-            self.name,
-            v.bridge_stiffness_n_m2,
-            v.thread_enabled,
-            v.thread_position_m,
-            v.bridge_beyond_thread,
-            v.gamma_per_s,
-            v.eta_s,
-            v.nut_pickup_weight,
-            v.quality.name(),
-            s.pluck.position_m,
-            s.pluck.width_m,
-            s.pluck.amplitude_m,
-            s.output_gain_db,
-            s.drone.enabled,
-            first_string_name(s.drone.first_string),
-            s.drone.tempo_sync,
-            s.drone.free_tempo_bpm,
-            INSTRUMENT_NAMES[s.instrument as usize],
-            BOW_MODEL_NAMES[s.bowed.player.tier as usize],
-            BOW_STRING_NAMES[s.bowed.string as usize],
-            s.bowed.pressure,
-            s.bowed.bow_velocity_m_s,
-            s.bowed.bow_position,
-            s.bowed.player.glide_time_s,
-            s.bowed.player.max_vibrato_cents,
-            s.bowed.player.body_enabled,
-        )
-    }
-}
-
-const KNOWN_KEYS: [&str; 26] = [
-    "name",
-    "bridge_stiffness_n_m2",
-    "thread_enabled",
-    "thread_position_m",
-    "bridge_beyond_thread",
-    "gamma_per_s",
-    "eta_s",
-    "nut_pickup_weight",
-    "quality",
-    "pluck_position_m",
-    "pluck_width_m",
-    "pluck_amplitude_m",
-    "output_gain_db",
-    "drone_enabled",
-    "drone_first_string",
-    "drone_tempo_sync",
-    "drone_tempo_bpm",
-    "instrument",
-    "bow_model",
-    "bow_string",
-    "bow_pressure",
-    "bow_velocity_m_s",
-    "bow_position",
-    "bow_glide_s",
-    "bow_vibrato_cents",
-    "bow_body",
-];
-
-/// Removes a `#` comment that is not inside a quoted string.
-fn strip_comment(line: &str) -> &str {
-    let mut in_string = false;
-    for (index, character) in line.char_indices() {
-        match character {
-            '"' => in_string = !in_string,
-            '#' if !in_string => return &line[..index],
-            _ => {}
-        }
-    }
-    line
-}
-
-struct Value<'a, E: Fn(&str, String) -> PresetError> {
-    text: &'a str,
-    key: &'a str,
-    make_error: &'a E,
-}
-
-impl<'a, E: Fn(&str, String) -> PresetError> Value<'a, E> {
-    fn fail(&self, expected: String) -> PresetError {
-        (self.make_error)(self.key, format!("{expected}, found `{}`", self.text))
-    }
-
-    fn number(&self, (min, max): (f64, f64)) -> Result<f64, PresetError> {
-        let expected = format!("a number from {min} to {max}");
-        let value: f64 = self.text.parse().map_err(|_| self.fail(expected.clone()))?;
-        if !(min <= value && value <= max) {
-            return Err(self.fail(expected));
-        }
-        Ok(value)
-    }
-
-    fn boolean(&self) -> Result<bool, PresetError> {
-        match self.text {
-            "true" => Ok(true),
-            "false" => Ok(false),
-            _ => Err(self.fail("true or false".to_string())),
-        }
-    }
-
-    fn string(&self) -> Result<&'a str, PresetError> {
-        self.text
-            .strip_prefix('"')
-            .and_then(|rest| rest.strip_suffix('"'))
-            .filter(|inner| !inner.contains('"'))
-            .ok_or_else(|| self.fail("a quoted string".to_string()))
-    }
-
-    fn choice(&self, choices: &[&'static str]) -> Result<&'static str, PresetError> {
-        let text = self.string()?;
-        choices
-            .iter()
-            .copied()
-            .find(|choice| *choice == text)
-            .ok_or_else(|| self.fail(format!("one of \"{}\"", choices.join("\", \""))))
+        let value = |value| Some(Spanned::new(0..0, value));
+        let text = |text: &str| Some(Spanned::new(0..0, text.to_string()));
+        let file = PresetFile {
+            name: text(&self.name),
+            bridge_stiffness_n_m2: value(v.bridge_stiffness_n_m2),
+            thread_enabled: Some(Spanned::new(0..0, v.thread_enabled)),
+            thread_position_m: value(v.thread_position_m),
+            bridge_beyond_thread: Some(Spanned::new(0..0, v.bridge_beyond_thread)),
+            gamma_per_s: value(v.gamma_per_s),
+            eta_s: value(v.eta_s),
+            nut_pickup_weight: value(v.nut_pickup_weight),
+            quality: text(v.quality.name()),
+            pluck_position_m: value(s.pluck.position_m),
+            pluck_width_m: value(s.pluck.width_m),
+            pluck_amplitude_m: value(s.pluck.amplitude_m),
+            output_gain_db: value(s.output_gain_db),
+            drone_enabled: Some(Spanned::new(0..0, s.drone.enabled)),
+            drone_first_string: text(first_string_name(s.drone.first_string)),
+            drone_tempo_sync: Some(Spanned::new(0..0, s.drone.tempo_sync)),
+            drone_tempo_bpm: value(s.drone.free_tempo_bpm),
+            instrument: text(INSTRUMENT_NAMES[s.instrument as usize]),
+            bow_model: text(BOW_MODEL_NAMES[s.bowed.player.tier as usize]),
+            bow_string: text(BOW_STRING_NAMES[s.bowed.string as usize]),
+            bow_pressure: value(s.bowed.pressure),
+            bow_velocity_m_s: value(s.bowed.bow_velocity_m_s),
+            bow_position: value(s.bowed.bow_position),
+            bow_glide_s: value(s.bowed.player.glide_time_s),
+            bow_vibrato_cents: value(s.bowed.player.max_vibrato_cents),
+            bow_body: Some(Spanned::new(0..0, s.bowed.player.body_enabled)),
+        };
+        toml::to_string(&file).expect("a flat table of numbers, strings and switches")
     }
 }
 
@@ -433,6 +559,52 @@ mod tests {
             let message = Preset::parse(text, "p.toml").unwrap_err().to_string();
             assert!(message.contains(expected), "{text}: {message}");
         }
+    }
+
+    #[test]
+    fn errors_name_the_line_of_the_key() {
+        let text = "# a comment\nname = \"x\"\ngamma_per_s = 0.5\nbridge_stifness = 1e8\n";
+        let error = Preset::parse(text, "p.toml").unwrap_err();
+        assert_eq!((error.line, error.field.as_str()), (4, "bridge_stifness"));
+        let error = Preset::parse("eta_s = 1e-9\n\neta_s = 2e-9\n", "p.toml").unwrap_err();
+        assert_eq!((error.line, error.field.as_str()), (3, "eta_s"));
+        let error = Preset::parse("name = \"x\"\nbow_body = 1\n", "p.toml").unwrap_err();
+        let message = error.to_string();
+        assert!(message.starts_with("p.toml:2: `bow_body`: expected true or false, found `1`"));
+        let error = Preset::parse("name = \"x\"\nbow_model = \"violin\"\n", "p.toml");
+        let message = error.unwrap_err().to_string();
+        assert!(message.starts_with("p.toml:2: `bow_model`"), "{message}");
+        assert!(
+            message.contains("\"rounded-corner\", \"bow-table\""),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn integers_and_any_name_are_read() {
+        let preset = Preset::parse("bow_vibrato_cents = 30\ndrone_tempo_bpm = 72\n", "p").unwrap();
+        assert_eq!(preset.settings.bowed.player.max_vibrato_cents, 30.0);
+        assert_eq!(preset.settings.drone.free_tempo_bpm, 72.0);
+        let preset = Preset {
+            name: "quote \" hash # backslash \\".to_string(),
+            settings: EngineSettings::default(),
+        };
+        assert_eq!(Preset::parse(&preset.to_text(), "mem").unwrap(), preset);
+    }
+
+    #[test]
+    fn text_lists_every_key_in_order() {
+        let text = Preset {
+            name: "all".to_string(),
+            settings: EngineSettings::default(),
+        }
+        .to_text();
+        let keys: Vec<&str> = text
+            .lines()
+            .filter_map(|line| line.split_once(" = ").map(|(key, _)| key))
+            .collect();
+        let expected: Vec<&str> = KEYS.iter().map(|(key, _)| *key).collect();
+        assert_eq!(keys, expected);
     }
 
     #[test]
