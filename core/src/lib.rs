@@ -19,5 +19,6 @@ pub mod banded;
 pub mod dense;
 pub mod engine;
 pub mod newton;
+pub mod simd;
 pub mod snapshot;
 pub mod snapshot_channel;

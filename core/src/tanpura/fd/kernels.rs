@@ -20,7 +20,8 @@
 //! the scalar path at round-off, and the same machine always takes the same path
 //! (deterministic renders).
 
-use pulp::{Arch, Simd, WithSimd};
+pub use crate::simd::Kernels;
+use pulp::{Simd, WithSimd};
 
 /// A run `start..end` of barrier points whose interpolation stencils all start at `first_node`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -30,35 +31,7 @@ pub struct StencilSegment {
     pub end: usize,
 }
 
-/// The instruction set chosen once per string, and the kernels dispatched on it.
-#[derive(Debug, Clone, Copy)]
-pub struct Kernels {
-    arch: Arch,
-}
-
-impl Default for Kernels {
-    fn default() -> Self {
-        Self::detect()
-    }
-}
-
 impl Kernels {
-    /// Detects the CPU's vector unit (once; the dispatch itself is a branch on an enum).
-    pub fn detect() -> Self {
-        Self { arch: Arch::new() }
-    }
-
-    /// The name of the instruction set in use.
-    pub fn name(&self) -> &'static str {
-        match self.arch {
-            #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
-            Arch::V4(_) => "AVX-512",
-            #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
-            Arch::V3(_) => "AVX2+FMA",
-            _ => "scalar",
-        }
-    }
-
     /// `y ← y + a x` over the common length.
     pub fn axpy(&self, a: f64, x: &[f64], y: &mut [f64]) {
         self.arch.dispatch(Axpy { a, x, y });

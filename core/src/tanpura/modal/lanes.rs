@@ -19,7 +19,8 @@
 //! render is bit-identical run to run; two machines with different vector units may differ at
 //! round-off.
 
-use pulp::{Arch, Simd, WithSimd};
+pub use crate::simd::Kernels;
+use pulp::{Simd, WithSimd};
 use std::fmt::Debug;
 
 /// Mode arrays are padded to a multiple of this many elements: two registers of 16 f32 lanes
@@ -285,35 +286,7 @@ impl<T: Real> WithSimd for Advance<'_, T> {
     }
 }
 
-/// The run-time selected vector unit and the kernels on it.
-#[derive(Debug, Clone, Copy)]
-pub struct Kernels {
-    arch: Arch,
-}
-
-impl Default for Kernels {
-    fn default() -> Self {
-        Self::detect()
-    }
-}
-
 impl Kernels {
-    /// The widest vector unit of this CPU.
-    pub fn detect() -> Self {
-        Self { arch: Arch::new() }
-    }
-
-    /// The vector unit in use, for reports ("AVX-512", "AVX2+FMA" or "scalar").
-    pub fn name(&self) -> &'static str {
-        match self.arch {
-            #[cfg(target_arch = "x86_64")]
-            Arch::V4(_) => "AVX-512",
-            #[cfg(target_arch = "x86_64")]
-            Arch::V3(_) => "AVX2+FMA",
-            _ => "scalar",
-        }
-    }
-
     /// `s = a p − b r`.
     pub fn free_step<T: Real>(&self, a: &[T], b: &[T], r: &[T], p: &[T], s: &mut [T]) {
         self.arch.dispatch(FreeStep { a, b, r, p, s });
