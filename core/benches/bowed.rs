@@ -1,261 +1,228 @@
-//! Cost of one bowed voice, both tiers: real-time factor = simulated seconds per wall-clock
-//! second of a single thread.
+//! Cost of one bowed voice, both tiers (divan): the rounded-corner [`BowedString`] and the bow
+//! table [`BowTableString`], body filter on and off, by block and by sample.
 //!
-//! `cargo bench -p javari-core --bench bowed`
+//! `cargo bench -p javari-core --bench bowed` (one group: `-- scene`, `-- instrument`,
+//! `-- steady`; one case, e.g. `-- 'scene::process::BowedString'`).
 //!
-//! Three sections:
+//! **Reading the figures.** Every benchmark iteration renders one fixed block of 0.1 s of output:
+//! 4410 samples at 44.1 kHz ([`BLOCK_SAMPLES`]; in `steady`, 0.1 s at that group's rate). Divan
+//! reports the time per iteration, so **real-time factor = 0.1 s / reported time** (100 µs is
+//! 1000× real time) for a single thread; ns per sample = reported time / 4410 at 44.1 kHz. Its
+//! throughput column counts output samples per second.
 //!
-//! 1. The `cargo xtask bench` scene (`BowedNote`): A3 = 220 Hz on the violin A constants,
-//!    β = 0.1, v_b = 0.1 m/s, F_b = 0.4 N, 44.1 kHz, rendered from rest (attack included) in
-//!    64-sample blocks into an `f32` buffer, body filter on and off; each block rendered by
-//!    `BowedVoice::process` (as xtask renders it) and, for comparison, by a `next_sample` call
-//!    per sample. Each figure is the median (and best) of [`SCENE_RUNS`] runs of [`SCENE_S`]
-//!    simulated seconds, each run from a reset voice; the median is the honest figure on a
-//!    shared machine, the best the least disturbed.
-//! 2. The same note played through [`BowedInstrument`] (MIDI note-on, every control smoothed and
-//!    set on the voice every sample, as the plugin plays it), both tiers, body on.
-//! 3. The steady-state table across sample rates (440 Hz, F_b = 0.3 N), best of [`RUNS`].
+//! **What is timed.** Each voice is built, prepared and given its controls once per benchmark
+//! (set-up, not timed) and then keeps playing across iterations: the bowed note is sustained, so
+//! every timed block after the first (which holds the attack and falls in divan's tuning pass)
+//! is the steady Helmholtz motion.
 //!
-//! Nothing here asserts: speed is measured, never tested (house style 13).
+//! - `scene`: the `cargo xtask bench` note (`BowedNote`): A3 = 220 Hz on the violin A constants,
+//!   β = 0.1, v_b = 0.1 m/s, F_b = 0.4 N, 44.1 kHz, in 64-sample blocks into an `f32` buffer,
+//!   body on and off; `scene::process` renders each block with `BowedVoice::process` (as xtask
+//!   and the plugin do), `scene::next_sample` with a `next_sample` call per sample.
+//! - `instrument`: the same note played through [`BowedInstrument`] (MIDI note 57, velocity 0.5,
+//!   every control smoothed and set on the voice every sample, as the plugin plays it), both
+//!   tiers, body on.
+//! - `steady`: the rate table (violin A, 440 Hz, β = 0.1, F_b = 0.3 N, v_b = 0.1 m/s; 44.1, 48,
+//!   96 and 192 kHz, body on and off), a `next_sample` call per sample, after 0.5 s of warm-up.
+//!
+//! For a profiler (`perf record`, `valgrind --tool=callgrind`), run one case alone with more
+//! samples, e.g. `cargo bench -p javari-core --bench bowed -- 'scene::process::BowedString'
+//! --sample-count 10000`, or with divan's `--test` to run each case exactly once.
+//!
+//! Nothing here asserts: speed is measured, never tested (house style 13). Under
+//! `cargo test --all-targets` divan runs each benchmark once.
 
-use std::hint::black_box;
-use std::time::Instant;
+use std::fmt;
 
+use divan::counter::ItemsCount;
+use divan::{black_box, Bencher};
 use javari_core::bowed::{
     BowTableString, BowTier, BowedCapacity, BowedEvent, BowedInstrument, BowedPlayerSettings,
     BowedString, BowedVoice, StringConstants,
 };
 
-/// Simulated seconds per run of the scene.
-const SCENE_S: f64 = 3.0;
+/// Output sample rate of the scene and the instrument, Hz.
+const RATE_HZ: f64 = 44_100.0;
 
-/// Runs per scene figure; the median and the best are reported.
-const SCENE_RUNS: usize = 9;
+/// Simulated seconds per benchmark iteration.
+const BLOCK_S: f64 = 0.1;
 
-/// Simulated seconds per run of the rate table.
-const SIMULATED_S: f64 = 4.0;
+/// Output samples per benchmark iteration at 44.1 kHz: 0.1 s.
+const BLOCK_SAMPLES: usize = 4410;
 
-/// Runs per rate-table figure; the fastest is reported.
-const RUNS: usize = 5;
+/// The `cargo xtask bench` (and typical host) block size.
+const HOST_BLOCK: usize = 64;
 
-/// The `cargo xtask bench` block size.
-const BLOCK: usize = 64;
-
-const SCENE_RATE_HZ: f64 = 44_100.0;
-
-/// Median and best of `runs` timings of `run` (each returns its elapsed seconds).
-fn median_and_best(runs: usize, mut run: impl FnMut() -> f64) -> (f64, f64) {
-    let mut times: Vec<f64> = (0..runs).map(|_| run()).collect();
-    times.sort_by(f64::total_cmp);
-    (times[times.len() / 2], times[0])
+fn main() {
+    divan::main();
 }
 
-/// The xtask `BowedNote` scene from rest, in 64-sample blocks rendered by
-/// [`BowedVoice::process`] (`per_sample` false, as xtask renders it) or by a
-/// [`BowedVoice::next_sample`] call per sample; elapsed seconds.
-fn scene_run<V: BowedVoice>(voice: &mut V, body: bool, per_sample: bool) -> f64 {
-    voice.prepare(SCENE_RATE_HZ).unwrap();
+/// Body filter on or off.
+#[derive(Clone, Copy)]
+enum Body {
+    On,
+    Off,
+}
+
+impl Body {
+    const BOTH: [Body; 2] = [Body::On, Body::Off];
+
+    fn enabled(self) -> bool {
+        matches!(self, Body::On)
+    }
+}
+
+impl fmt::Display for Body {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(if self.enabled() {
+            "body on"
+        } else {
+            "body off"
+        })
+    }
+}
+
+/// A bowed tier with its constructor, for generic benchmarks.
+trait Voice: BowedVoice {
+    fn build() -> Self;
+}
+
+impl Voice for BowedString {
+    fn build() -> Self {
+        BowedString::new(BowedCapacity::default(), StringConstants::violin_a())
+    }
+}
+
+impl Voice for BowTableString {
+    fn build() -> Self {
+        BowTableString::new(BowedCapacity::default(), StringConstants::violin_a())
+    }
+}
+
+/// The xtask `BowedNote` scene's voice, prepared and bowing (at rest: the first block holds the
+/// attack).
+fn scene_voice<V: Voice>(body: Body) -> V {
+    let mut voice = V::build();
+    voice.prepare(RATE_HZ).unwrap();
     voice.set_pitch_hz(220.0);
     voice.set_bow_position(0.1);
     voice.set_bow_velocity_m_s(0.1);
     voice.set_bow_force_n(0.4);
-    voice.set_body_enabled(body);
-    let samples = (SCENE_S * SCENE_RATE_HZ) as usize;
-    let mut block = [0.0f32; BLOCK];
-    let mut sum = 0.0f32;
-    let start = Instant::now();
-    let mut done = 0;
-    while done < samples {
-        let length = BLOCK.min(samples - done);
-        if per_sample {
-            for sample in block[..length].iter_mut() {
-                *sample = voice.next_sample().radiated as f32;
-            }
-        } else {
-            voice.process(&mut block[..length]);
-        }
-        sum += black_box(&block)[0];
-        done += length;
-    }
-    let elapsed = start.elapsed().as_secs_f64();
-    black_box(sum);
-    elapsed
+    voice.set_body_enabled(body.enabled());
+    voice
 }
 
-/// The same note through the MIDI instrument (setters every sample); elapsed seconds.
-fn instrument_run(tier: BowTier) -> f64 {
+mod scene {
+    use super::*;
+
+    /// 0.1 s in 64-sample blocks, each rendered by `BowedVoice::process`.
+    #[divan::bench(types = [BowedString, BowTableString], args = Body::BOTH)]
+    fn process<V: Voice>(bencher: Bencher, body: Body) {
+        let mut voice = scene_voice::<V>(body);
+        let mut output = vec![0.0f32; BLOCK_SAMPLES];
+        bencher
+            .counter(ItemsCount::new(BLOCK_SAMPLES))
+            .bench_local(|| {
+                for block in output.chunks_mut(HOST_BLOCK) {
+                    voice.process(block);
+                }
+                black_box(&output);
+            });
+    }
+
+    /// 0.1 s in 64-sample blocks, each filled by a `BowedVoice::next_sample` call per sample.
+    #[divan::bench(types = [BowedString, BowTableString], args = Body::BOTH)]
+    fn next_sample<V: Voice>(bencher: Bencher, body: Body) {
+        let mut voice = scene_voice::<V>(body);
+        let mut output = vec![0.0f32; BLOCK_SAMPLES];
+        bencher
+            .counter(ItemsCount::new(BLOCK_SAMPLES))
+            .bench_local(|| {
+                for block in output.chunks_mut(HOST_BLOCK) {
+                    for sample in block.iter_mut() {
+                        *sample = voice.next_sample().radiated as f32;
+                    }
+                }
+                black_box(&output);
+            });
+    }
+}
+
+/// The scene's note through the MIDI instrument (controls smoothed and set every sample), body
+/// on; 0.1 s in 64-sample blocks of `BowedInstrument::next_sample`.
+#[divan::bench(args = [BowTier::RoundedCorner, BowTier::BowTable])]
+fn instrument(bencher: Bencher, tier: BowTier) {
     let settings = BowedPlayerSettings {
         tier,
         ..BowedPlayerSettings::default()
     };
-    let mut player =
-        BowedInstrument::new(StringConstants::violin_a(), settings, SCENE_RATE_HZ).unwrap();
+    let mut player = BowedInstrument::new(StringConstants::violin_a(), settings, RATE_HZ).unwrap();
     player.handle(BowedEvent::NoteOn {
         note: 57,
         velocity: 0.5,
     });
-    let samples = (SCENE_S * SCENE_RATE_HZ) as usize;
-    let mut block = [0.0f32; BLOCK];
-    let mut sum = 0.0f32;
-    let start = Instant::now();
-    let mut done = 0;
-    while done < samples {
-        let length = BLOCK.min(samples - done);
-        for sample in block[..length].iter_mut() {
-            *sample = player.next_sample() as f32;
-        }
-        sum += black_box(&block)[0];
-        done += length;
-    }
-    let elapsed = start.elapsed().as_secs_f64();
-    black_box(sum);
-    elapsed
+    let mut output = vec![0.0f32; BLOCK_SAMPLES];
+    bencher
+        .counter(ItemsCount::new(BLOCK_SAMPLES))
+        .bench_local(|| {
+            for block in output.chunks_mut(HOST_BLOCK) {
+                for sample in block.iter_mut() {
+                    *sample = player.next_sample() as f32;
+                }
+            }
+            black_box(&output);
+        });
 }
 
-fn steady<V: BowedVoice>(voice: &mut V, sample_rate_hz: f64, body: bool) -> (f64, f64) {
-    voice.prepare(sample_rate_hz).unwrap();
+/// One case of the rate table.
+#[derive(Clone, Copy)]
+struct RateCase {
+    rate_hz: f64,
+    body: Body,
+}
+
+impl fmt::Display for RateCase {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} kHz, {}", self.rate_hz / 1000.0, self.body)
+    }
+}
+
+const RATE_CASES: [RateCase; 8] = {
+    const fn case(rate_hz: f64, body: Body) -> RateCase {
+        RateCase { rate_hz, body }
+    }
+    [
+        case(44_100.0, Body::Off),
+        case(44_100.0, Body::On),
+        case(48_000.0, Body::Off),
+        case(48_000.0, Body::On),
+        case(96_000.0, Body::Off),
+        case(96_000.0, Body::On),
+        case(192_000.0, Body::Off),
+        case(192_000.0, Body::On),
+    ]
+};
+
+/// Steady Helmholtz motion at 440 Hz (F_b = 0.3 N) after 0.5 s of warm-up; 0.1 s at the case's
+/// rate, a `next_sample` call per sample.
+#[divan::bench(types = [BowedString, BowTableString], args = RATE_CASES)]
+fn steady<V: Voice>(bencher: Bencher, case: RateCase) {
+    let mut voice = V::build();
+    voice.prepare(case.rate_hz).unwrap();
     voice.set_pitch_hz(440.0);
     voice.set_bow_position(0.1);
     voice.set_bow_velocity_m_s(0.1);
     voice.set_bow_force_n(0.3);
-    voice.set_body_enabled(body);
-    // Warm up past the attack so the steady Helmholtz motion is what is timed.
-    for _ in 0..(0.5 * sample_rate_hz) as usize {
+    voice.set_body_enabled(case.body.enabled());
+    for _ in 0..(0.5 * case.rate_hz) as usize {
         black_box(voice.next_sample());
     }
-    let samples = (SIMULATED_S * sample_rate_hz) as usize;
-    let mut best = f64::INFINITY;
-    for _ in 0..RUNS {
-        let start = Instant::now();
+    let samples = (BLOCK_S * case.rate_hz).round() as usize;
+    bencher.counter(ItemsCount::new(samples)).bench_local(|| {
         let mut sum = 0.0;
         for _ in 0..samples {
-            sum += black_box(voice.next_sample()).radiated;
+            sum += voice.next_sample().radiated;
         }
-        best = best.min(start.elapsed().as_secs_f64());
         black_box(sum);
-    }
-    (SIMULATED_S / best, 1e9 * best / samples as f64)
-}
-
-/// `cargo bench -p javari-core --bench bowed -- profile TIER BODY SECONDS [per-sample]` runs
-/// only the xtask scene for one voice (TIER `rounded` | `table` | `instrument-rounded` |
-/// `instrument-table`, BODY `on` | `off`), for `perf record` or `valgrind --tool=callgrind`,
-/// and prints its real-time factor.
-fn profile(args: &[String]) {
-    let tier = args.first().map(String::as_str).unwrap_or("rounded");
-    let body = args.get(1).map(String::as_str) != Some("off");
-    let seconds: f64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(30.0);
-    let per_sample = args.get(3).map(String::as_str) == Some("per-sample");
-    let runs = (seconds / SCENE_S).ceil().max(1.0) as usize;
-    let capacity = BowedCapacity::default();
-    let mut rounded = BowedString::new(capacity, StringConstants::violin_a());
-    let mut table = BowTableString::new(capacity, StringConstants::violin_a());
-    let mut total = 0.0;
-    for _ in 0..runs {
-        total += match tier {
-            "table" => scene_run(&mut table, body, per_sample),
-            "instrument-rounded" => instrument_run(BowTier::RoundedCorner),
-            "instrument-table" => instrument_run(BowTier::BowTable),
-            _ => scene_run(&mut rounded, body, per_sample),
-        };
-    }
-    println!(
-        "profile {tier}, body {}: {runs} runs, real-time factor {:.0}",
-        on_off(body),
-        runs as f64 * SCENE_S / total
-    );
-}
-
-fn main() {
-    let args: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| a != "--bench")
-        .collect();
-    if args.first().map(String::as_str) == Some("profile") {
-        profile(&args[1..]);
-        return;
-    }
-    let capacity = BowedCapacity::default();
-    let scene_samples = SCENE_S * SCENE_RATE_HZ;
-
-    println!(
-        "1. xtask scene: A3 220 Hz, violin A constants, β = 0.1, v_b = 0.1 m/s, F_b = 0.4 N, \
-         44.1 kHz, from rest, 64-sample blocks; median (best) of {SCENE_RUNS} runs of {SCENE_S} s"
-    );
-    println!(
-        "{:<28} {:>6} {:>24} {:>20}",
-        "tier", "body", "real-time factor", "ns/sample"
-    );
-    for (per_sample, mode) in [(false, "process"), (true, "next_sample")] {
-        for body in [true, false] {
-            let mut rounded = BowedString::new(capacity, StringConstants::violin_a());
-            let (median, best) =
-                median_and_best(SCENE_RUNS, || scene_run(&mut rounded, body, per_sample));
-            let name = format!("rounded corner, {mode}");
-            print_scene_row(&name, body, median, best, scene_samples);
-            let mut table = BowTableString::new(capacity, StringConstants::violin_a());
-            let (median, best) =
-                median_and_best(SCENE_RUNS, || scene_run(&mut table, body, per_sample));
-            let name = format!("bow table, {mode}");
-            print_scene_row(&name, body, median, best, scene_samples);
-        }
-    }
-
-    println!();
-    println!(
-        "2. the same note through BowedInstrument (MIDI note 57, velocity 0.5, controls smoothed \
-         and set every sample), body on; median (best) of {SCENE_RUNS} runs"
-    );
-    for (name, tier) in [
-        ("rounded corner", BowTier::RoundedCorner),
-        ("bow table", BowTier::BowTable),
-    ] {
-        let (median, best) = median_and_best(SCENE_RUNS, || instrument_run(tier));
-        print_scene_row(name, true, median, best, scene_samples);
-    }
-
-    println!();
-    println!(
-        "3. steady state, violin A constants, 440 Hz, β = 0.1, F_b = 0.3 N, v_b = 0.1 m/s; \
-         best of {RUNS} runs of {SIMULATED_S} s"
-    );
-    println!(
-        "{:<28} {:>10} {:>6} {:>16} {:>12}",
-        "tier", "rate (Hz)", "body", "real-time factor", "ns/sample"
-    );
-    for &rate in &[44_100.0, 48_000.0, 96_000.0, 192_000.0] {
-        for body in [false, true] {
-            let mut rounded = BowedString::new(capacity, StringConstants::violin_a());
-            let (rtf, ns) = steady(&mut rounded, rate, body);
-            print_rate_row("rounded corner", rate, body, rtf, ns);
-            let mut table = BowTableString::new(capacity, StringConstants::violin_a());
-            let (rtf, ns) = steady(&mut table, rate, body);
-            print_rate_row("bow table", rate, body, rtf, ns);
-        }
-    }
-}
-
-fn on_off(body: bool) -> &'static str {
-    if body {
-        "on"
-    } else {
-        "off"
-    }
-}
-
-fn print_scene_row(tier: &str, body: bool, median_s: f64, best_s: f64, samples: f64) {
-    let rtf = format!("{:.0} ({:.0})", SCENE_S / median_s, SCENE_S / best_s);
-    let ns = format!(
-        "{:.1} ({:.1})",
-        1e9 * median_s / samples,
-        1e9 * best_s / samples
-    );
-    println!("{tier:<28} {:>6} {rtf:>24} {ns:>20}", on_off(body));
-}
-
-fn print_rate_row(tier: &str, rate: f64, body: bool, rtf: f64, ns: f64) {
-    println!(
-        "{tier:<28} {rate:>10.0} {:>6} {rtf:>16.0} {ns:>12.1}",
-        on_off(body)
-    );
+    });
 }

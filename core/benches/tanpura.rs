@@ -1,63 +1,118 @@
-//! `cargo bench -p javari-core --bench tanpura`: real-time factors (simulated seconds per CPU
-//! second) of one string and of the four-string instrument at the seed's reference
-//! configuration (Δx = 3.34 mm, 4 × 44.1 kHz, full Newton to 1e-13 m through the condensed
-//! solver), with the Newton iteration statistics. Also the plain full-Newton reference path.
+//! Cost of the tanpura: one string at the modal live tier and at the FD reference tier, the
+//! four-string instrument, and the reference FD string's two Newton solvers (divan).
+//!
+//! `cargo bench -p javari-core --bench tanpura` (one group: `-- one_string`, `-- four_strings`,
+//! `-- fd_string`).
+//!
+//! **Reading the figures.** Every benchmark iteration renders one fixed block of 0.1 s: 4410
+//! output samples at 44.1 kHz ([`BLOCK_SAMPLES`]), or for `fd_string` the 17 640 FD steps of 0.1 s
+//! at the reference's 4 × 44.1 kHz. Divan reports the time per iteration, so
+//! **real-time factor = 0.1 s / reported time** (10 ms is 10× real time, 200 ms is 0.5×); its
+//! throughput column counts output samples (FD steps for `fd_string`) per second.
+//!
+//! **What is timed.** Each iteration starts from the same state, a string (or all four strings)
+//! plucked with `Pluck::default()` (2 mm at 0.35 m, 10 mm fingertip) from rest, and times the
+//! first 0.1 s after the release, where the contact with bridge and thread is busiest. Building
+//! the voice (once per benchmark), cloning it and plucking it (the static pluck solve) are set-up
+//! and are not timed.
+//!
+//! - `one_string`: a [`TanpuraVoice`] at the seed's reference string and settings
+//!   ([`VoiceSettings::default`]) on the modal live tier (the plugin default) and on the FD
+//!   reference tier (4 × oversampled, Δx = 3.34 mm, Newton to 1e-13 m through the condensed
+//!   solver, with its decimator), rendered by `TanpuraVoice::process`.
+//! - `four_strings`: the [`Tanpura`] drone (Pa, Sa, Sa, low Sa on the same settings), all four
+//!   strings plucked together, one `Tanpura::next_sample` per output sample, at both tiers.
+//! - `fd_string`: the reference [`FdString`] stepped alone (no voice, no decimator) with the
+//!   condensed solver and with the plain full Newton.
+//!
+//! Newton's iteration counts are not reported here (`cargo xtask bench` and `cargo xtask simulate`
+//! give them). Nothing here asserts: speed is measured, never tested (house style 13). Under
+//! `cargo test --all-targets` divan runs each benchmark once.
 
+use divan::counter::ItemsCount;
+use divan::{black_box, Bencher};
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::fd::{FdString, FdStringConfig, SolverKind};
-use javari_core::tanpura::{Tanpura, VoiceSettings};
-use std::time::Instant;
+use javari_core::tanpura::quality::Quality;
+use javari_core::tanpura::{Tanpura, TanpuraVoice, VoiceSettings};
 
-const SECONDS: f64 = 2.0;
+/// Output sample rate, Hz.
+const RATE_HZ: f64 = 44_100.0;
 
-fn one_string(solver: SolverKind) {
-    let mut config = FdStringConfig::REFERENCE;
-    config.solver = solver;
-    let mut string = FdString::new(config);
-    string.pluck(&Pluck::default());
-    let steps = (SECONDS / config.time_step_s) as usize;
-    let start = Instant::now();
-    for _ in 0..steps {
-        string.step();
-    }
-    let elapsed = start.elapsed().as_secs_f64();
-    let stats = string.newton_stats();
-    println!(
-        "one string, {solver:?}: {:.2}x real time ({:.2} us per step); Newton mean {:.2}, max {}, cap hits {}",
-        SECONDS / elapsed,
-        elapsed / steps as f64 * 1e6,
-        stats.mean_iterations(),
-        stats.max_iterations,
-        stats.cap_hits
-    );
-}
+/// Simulated seconds per benchmark iteration.
+const BLOCK_S: f64 = 0.1;
 
-fn four_strings() {
-    let settings = VoiceSettings::default();
-    let mut tanpura = Tanpura::new(&settings, settings.fundamental_hz, 44_100.0);
-    for index in 0..4 {
-        tanpura.pluck(index, &Pluck::default());
-    }
-    let samples = (SECONDS * 44_100.0) as usize;
-    let start = Instant::now();
-    let mut checksum = 0.0f64;
-    for _ in 0..samples {
-        checksum += tanpura.next_sample() as f64;
-    }
-    let elapsed = start.elapsed().as_secs_f64();
-    let stats = tanpura.newton_stats();
-    println!(
-        "four-string tanpura: {:.2}x real time; Newton mean {:.2}, max {}, cap hits {} (checksum {checksum:.3e})",
-        SECONDS / elapsed,
-        stats.mean_iterations(),
-        stats.max_iterations,
-        stats.cap_hits
-    );
-}
+/// Output samples per benchmark iteration: 0.1 s at 44.1 kHz.
+const BLOCK_SAMPLES: usize = 4410;
+
+/// The tiers compared: the plugin's default and the renderer's.
+const TIERS: [Quality; 2] = [Quality::Live, Quality::Reference];
 
 fn main() {
-    println!("tanpura at the reference configuration, {SECONDS} s simulated after a pluck");
-    one_string(SolverKind::Condensed);
-    one_string(SolverKind::FullNewton);
-    four_strings();
+    divan::main();
+}
+
+fn settings(quality: Quality) -> VoiceSettings {
+    VoiceSettings {
+        quality,
+        ..VoiceSettings::default()
+    }
+}
+
+#[divan::bench(args = TIERS, max_time = 10)]
+fn one_string(bencher: Bencher, quality: Quality) {
+    let voice = TanpuraVoice::new(&settings(quality), RATE_HZ);
+    bencher
+        .counter(ItemsCount::new(BLOCK_SAMPLES))
+        .with_inputs(|| {
+            let mut voice = voice.clone();
+            voice.pluck(&Pluck::default());
+            (voice, vec![0.0f32; BLOCK_SAMPLES])
+        })
+        .bench_local_refs(|(voice, block)| {
+            voice.process(block);
+            black_box(block);
+        });
+}
+
+#[divan::bench(args = TIERS, max_time = 10)]
+fn four_strings(bencher: Bencher, quality: Quality) {
+    let settings = settings(quality);
+    let tanpura = Tanpura::new(&settings, settings.fundamental_hz, RATE_HZ);
+    bencher
+        .counter(ItemsCount::new(BLOCK_SAMPLES))
+        .with_inputs(|| {
+            let mut tanpura = tanpura.clone();
+            for index in 0..4 {
+                tanpura.pluck(index, &Pluck::default());
+            }
+            (tanpura, vec![0.0f32; BLOCK_SAMPLES])
+        })
+        .bench_local_refs(|(tanpura, block)| {
+            for sample in block.iter_mut() {
+                *sample = tanpura.next_sample();
+            }
+            black_box(block);
+        });
+}
+
+#[divan::bench(args = [SolverKind::Condensed, SolverKind::FullNewton], max_time = 10)]
+fn fd_string(bencher: Bencher, solver: SolverKind) {
+    let mut config = FdStringConfig::REFERENCE;
+    config.solver = solver;
+    let steps = (BLOCK_S / config.time_step_s).round() as usize;
+    let string = FdString::new(config);
+    bencher
+        .counter(ItemsCount::new(steps))
+        .with_inputs(|| {
+            let mut string = string.clone();
+            string.pluck(&Pluck::default());
+            string
+        })
+        .bench_local_refs(|string| {
+            for _ in 0..steps {
+                string.step();
+            }
+            black_box(string.nut_force_n());
+        });
 }
