@@ -8,7 +8,7 @@ use super::excitation::Pluck;
 use super::fd::FdString;
 use super::modal::ModalString;
 use super::string::StringParameters;
-use crate::newton::{NewtonSettings, NewtonStats};
+use crate::newton::NewtonStats;
 
 /// The string a tier runs.
 #[derive(Debug, Clone)]
@@ -96,14 +96,6 @@ impl TierString {
         match self {
             TierString::FiniteDifference(string) => &string.config().string,
             TierString::Modal(string) => &string.config().string,
-        }
-    }
-
-    /// Newton's tolerance and cap.
-    pub fn newton_settings(&self) -> NewtonSettings {
-        match self {
-            TierString::FiniteDifference(string) => string.config().newton,
-            TierString::Modal(string) => string.config().newton,
         }
     }
 

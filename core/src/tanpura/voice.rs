@@ -210,6 +210,7 @@ impl VoiceSettings {
         });
         config.string = self.string_parameters(config.speaking_start_m());
         config.string.bending_stiffness_n_m2 = dispersion_compensated_stiffness(
+            quality,
             &config.string,
             config.speaking_start_m(),
             config.string.length_m / config.intervals as f64,
@@ -217,9 +218,6 @@ impl VoiceSettings {
             self.fundamental_hz,
             output_sample_rate_hz,
         );
-        if quality == Quality::Reference {
-            config.string.bending_stiffness_n_m2 = StringParameters::SEED.bending_stiffness_n_m2;
-        }
         config.newton = tier.newton;
         config.solver = tier.solver;
         Some(config)
@@ -302,8 +300,9 @@ fn dispersion_per_n_squared(
 /// its `B` by `2(c_tier − c_reference)` cancels the difference to leading order, so the first ten
 /// partials of every FD tier stay close to the reference's. The reference keeps the seed's EI
 /// (its own dispersion flattens the tenth partial by about 2.6 cents against the continuous
-/// string, which the modal tiers reproduce exactly).
+/// string by the leading-order estimate above, which the modal tiers reproduce exactly).
 fn dispersion_compensated_stiffness(
+    quality: Quality,
     string: &StringParameters,
     speaking_start_m: f64,
     spacing_m: f64,
@@ -311,10 +310,13 @@ fn dispersion_compensated_stiffness(
     fundamental_hz: f64,
     output_sample_rate_hz: f64,
 ) -> f64 {
+    if quality == Quality::Reference {
+        return string.bending_stiffness_n_m2;
+    }
     let speaking = string.length_m - speaking_start_m;
-    let reference = Quality::Reference
-        .fd_tier()
-        .expect("the reference tier is FD");
+    let Some(reference) = Quality::Reference.fd_tier() else {
+        return string.bending_stiffness_n_m2;
+    };
     let reference_dispersion = dispersion_per_n_squared(
         string.length_m / reference.intervals as f64,
         1.0 / (output_sample_rate_hz * reference.oversample as f64),
@@ -357,12 +359,14 @@ impl TanpuraVoice {
         let strings = Quality::ALL
             .iter()
             .map(|&quality| {
-                if let Some(config) = build.modal_config_at(quality, output_sample_rate_hz) {
-                    TierString::Modal(Box::new(ModalString::new(config)))
-                } else if let Some(config) = build.fd_config_at(quality, output_sample_rate_hz) {
-                    TierString::FiniteDifference(Box::new(FdString::new(config)))
-                } else {
-                    unreachable!("every tier is modal or FD")
+                match build.modal_config_at(quality, output_sample_rate_hz) {
+                    Some(config) => TierString::Modal(Box::new(ModalString::new(config))),
+                    // Every tier that is not modal is FD.
+                    None => TierString::FiniteDifference(Box::new(FdString::new(
+                        build
+                            .fd_config_at(quality, output_sample_rate_hz)
+                            .unwrap_or_default(),
+                    ))),
                 }
             })
             .collect();

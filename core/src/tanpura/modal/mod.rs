@@ -823,21 +823,11 @@ impl<T: Real> ModalString<T> {
         (&self.modal[..count], &self.velocity[..count])
     }
 
-    /// The points Newton iterates on now (those near contact or loaded at rest).
-    pub fn tracked_points(&self) -> usize {
-        self.contact.tracked_count
-    }
-
     /// The gaps a_i of the points, m (positive: the string penetrates): exact for the points near
     /// contact, the last computed value for the far ones (whose gaps are only bounded while they
     /// cannot touch; [`ModalString::displacement_at_m`] gives the exact shape anywhere).
     pub fn gaps_m(&self) -> &[f64] {
         &self.contact.gaps_m[..self.points.len()]
-    }
-
-    /// The vector unit the mode kernels run on.
-    pub fn vector_unit(&self) -> &'static str {
-        self.kernels.name()
     }
 
     /// The fundamental of small vibrations about the rest state with every point in contact at
