@@ -16,6 +16,7 @@ pub mod tanpura;
 
 pub mod analysis;
 pub mod banded;
+pub mod denormals;
 pub mod dense;
 pub mod engine;
 pub mod newton;

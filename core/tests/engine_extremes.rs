@@ -1,10 +1,17 @@
 //! The engine at the extremes a host can throw at it: block sizes from 1 to 8192, output rates
 //! from 22.05 kHz to 384 kHz, both instruments. The output must not depend on the block size
-//! (events sit at absolute sample times) and must stay finite and below full scale.
+//! (events sit at absolute sample times) and must stay finite and below full scale. Non-finite
+//! and out-of-range settings and events, as broken automation or a foreign state would send, are
+//! clamped at the engine's boundary. The reported latency follows the tier.
 
 use javari_core::engine::render::{render, RenderOptions, Score};
-use javari_core::engine::{EngineSettings, Instrument};
+use javari_core::engine::{preset, Engine};
+use javari_core::engine::{
+    EngineEvent, EngineSettings, Instrument, TimedEvent, OUTPUT_GAIN_RANGE_DB,
+};
+use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
+use javari_core::tanpura::VoiceSettings;
 
 fn score() -> Score {
     let mut score = Score::default();
@@ -67,4 +74,221 @@ fn output_rates_from_22050_to_384000_stay_finite_and_below_full_scale() {
             );
         }
     }
+}
+
+/// Every number of the settings set to `value` (switches and choices as given).
+fn every_number_set_to(value: f64, instrument: Instrument) -> EngineSettings {
+    let mut settings = EngineSettings {
+        instrument,
+        ..EngineSettings::default()
+    };
+    settings.voice.quality = Quality::Draft;
+    settings.drone.enabled = instrument == Instrument::Tanpura;
+    settings.drone.tempo_sync = false;
+    let voice = &mut settings.voice;
+    voice.fundamental_hz = value;
+    voice.bridge_stiffness_n_m2 = value;
+    voice.thread_position_m = value;
+    voice.gamma_per_s = value;
+    voice.eta_s = value;
+    voice.nut_pickup_weight = value;
+    settings.pluck = Pluck {
+        position_m: value,
+        width_m: value,
+        amplitude_m: value,
+    };
+    settings.output_gain_db = value;
+    settings.drone.free_tempo_bpm = value;
+    let bowed = &mut settings.bowed;
+    bowed.pressure = value;
+    bowed.bow_velocity_m_s = value;
+    bowed.bow_position = value;
+    bowed.player.glide_time_s = value;
+    bowed.player.vibrato_rate_hz = value;
+    bowed.player.max_vibrato_cents = value;
+    bowed.player.pitch_bend_range_semitones = value;
+    bowed.player.bow_lift_time_s = value;
+    settings
+}
+
+fn assert_within(name: &str, value: f64, (min, max): (f64, f64)) {
+    assert!(
+        (min..=max).contains(&value),
+        "{name} = {value} outside {min}..{max}"
+    );
+}
+
+fn assert_valid(settings: &EngineSettings) {
+    assert!(settings.voice.validate().is_ok(), "{:?}", settings.voice);
+    let pluck = settings.pluck;
+    assert_within(
+        "pluck position",
+        pluck.position_m,
+        preset::PLUCK_POSITION_RANGE_M,
+    );
+    assert_within("pluck width", pluck.width_m, Pluck::WIDTH_RANGE_M);
+    assert_within(
+        "pluck amplitude",
+        pluck.amplitude_m,
+        Pluck::AMPLITUDE_RANGE_M,
+    );
+    assert_within("gain", settings.output_gain_db, OUTPUT_GAIN_RANGE_DB);
+    let tempo = javari_core::engine::drone::TEMPO_RANGE_BPM;
+    assert_within("drone tempo", settings.drone.free_tempo_bpm, tempo);
+    let bowed = settings.bowed;
+    assert_within("bow pressure", bowed.pressure, (0.0, 1.0));
+    assert_within(
+        "bow speed",
+        bowed.bow_velocity_m_s,
+        preset::BOW_VELOCITY_RANGE_M_S,
+    );
+    assert_within(
+        "bow position",
+        bowed.bow_position,
+        preset::BOW_POSITION_RANGE,
+    );
+    assert_within(
+        "glide",
+        bowed.player.glide_time_s,
+        preset::BOW_GLIDE_RANGE_S,
+    );
+    let player = bowed.player;
+    assert!(player.vibrato_rate_hz.is_finite() && player.max_vibrato_cents.is_finite());
+    assert!(player.pitch_bend_range_semitones.is_finite() && player.bow_lift_time_s > 0.0);
+}
+
+/// NaN, ±∞ and values far outside every range, as settings (at construction and as automation
+/// while strings ring) and as event values: the applied settings are valid, NaN takes the
+/// default, and the output stays finite and bounded.
+#[test]
+fn non_finite_and_out_of_range_values_are_clamped() {
+    let nan = every_number_set_to(f64::NAN, Instrument::Tanpura).clamped();
+    assert_valid(&nan);
+    let default = EngineSettings::default();
+    assert_eq!(nan.voice.gamma_per_s, default.voice.gamma_per_s);
+    assert_eq!(nan.pluck, default.pluck);
+    assert_eq!(nan.output_gain_db, default.output_gain_db);
+    assert_eq!(nan.drone.free_tempo_bpm, default.drone.free_tempo_bpm);
+    assert_eq!(nan.bowed.pressure, default.bowed.pressure);
+    let huge = every_number_set_to(1e300, Instrument::Tanpura).clamped();
+    assert_eq!(huge.output_gain_db, OUTPUT_GAIN_RANGE_DB.1);
+    assert_eq!(huge.voice.gamma_per_s, VoiceSettings::GAMMA_RANGE.1);
+
+    let hostile_events = [
+        EngineEvent::NoteOn {
+            note: 57,
+            velocity: f32::NAN,
+        },
+        EngineEvent::NoteOn {
+            note: 200,
+            velocity: f32::INFINITY,
+        },
+        EngineEvent::Controller {
+            number: 2,
+            value: f32::NAN,
+        },
+        EngineEvent::Controller {
+            number: 11,
+            value: 1e30,
+        },
+        EngineEvent::ChannelPressure(f32::NEG_INFINITY),
+        EngineEvent::PolyPressure {
+            note: 57,
+            value: -1e30,
+        },
+        EngineEvent::PitchBend(f32::NAN),
+        EngineEvent::PitchBend(1e30),
+    ];
+    assert_eq!(hostile_events[0].sanitised(), None);
+    assert_eq!(
+        hostile_events[3].sanitised(),
+        Some(EngineEvent::Controller {
+            number: 11,
+            value: 1.0
+        })
+    );
+    assert_eq!(
+        hostile_events[7].sanitised(),
+        Some(EngineEvent::PitchBend(1.0))
+    );
+
+    let values = [
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        1e300,
+        -1e300,
+        0.0,
+    ];
+    for instrument in [Instrument::Tanpura, Instrument::Bowed] {
+        for (index, &value) in values.iter().enumerate() {
+            let hostile = every_number_set_to(value, instrument);
+            let mut engine = Engine::new(&hostile, 44_100.0, 4);
+            assert_valid(engine.settings());
+            let mut calm = settings(instrument);
+            calm.drone.enabled = false;
+            engine.set_settings(&calm);
+            let mut block = [0.0f32; 256];
+            let note = [TimedEvent {
+                offset: 0,
+                event: EngineEvent::NoteOn {
+                    note: 57,
+                    velocity: 0.8,
+                },
+            }];
+            engine.process(&note, &mut block);
+            let mut peak = 0.0f32;
+            for block_index in 0..80 {
+                // Automation every block while the string rings, alternating hostile and
+                // ordinary values, and every hostile event once.
+                let automated = if block_index % 2 == 0 {
+                    every_number_set_to(values[(index + block_index) % values.len()], instrument)
+                } else {
+                    calm
+                };
+                engine.set_settings(&automated);
+                assert_valid(engine.settings());
+                let events: Vec<TimedEvent> = hostile_events
+                    .iter()
+                    .enumerate()
+                    .map(|(offset, &event)| TimedEvent { offset, event })
+                    .collect();
+                let events = if block_index == 3 { &events[..] } else { &[] };
+                engine.process(events, &mut block);
+                for &sample in &block {
+                    assert!(
+                        sample.is_finite(),
+                        "{instrument:?}, {value}: non-finite output"
+                    );
+                    peak = peak.max(sample.abs());
+                }
+            }
+            // The hostile values include the largest gain, +24 dB (×15.8): bounded by that.
+            assert!(peak < 16.0, "{instrument:?}, {value}: peak {peak}");
+        }
+    }
+}
+
+/// The latency a host is told: 0 at the modal tiers and for the bowed string, the decimator's
+/// delay (a few samples, more at 4× than at 2× oversampling) at the FD tiers; it follows a tier
+/// change at once.
+#[test]
+fn latency_follows_the_tier() {
+    let mut settings = settings(Instrument::Tanpura);
+    let mut engine = Engine::new(&settings, 44_100.0, 2);
+    let mut latency = |quality: Quality, instrument: Instrument| {
+        settings.voice.quality = quality;
+        settings.instrument = instrument;
+        engine.set_settings(&settings);
+        engine.latency_samples()
+    };
+    assert_eq!(latency(Quality::Draft, Instrument::Tanpura), 0.0);
+    assert_eq!(latency(Quality::Live, Instrument::Tanpura), 0.0);
+    let studio = latency(Quality::Studio, Instrument::Tanpura);
+    let reference = latency(Quality::Reference, Instrument::Tanpura);
+    println!("latency: studio {studio} samples, reference {reference} samples");
+    assert!(studio > 1.0 && studio < 200.0, "{studio}");
+    assert!(reference > 1.0 && reference < 200.0, "{reference}");
+    assert_eq!(latency(Quality::Reference, Instrument::Bowed), 0.0);
+    assert_eq!(latency(Quality::Live, Instrument::Tanpura), 0.0);
 }

@@ -50,6 +50,14 @@ pub struct BowedPlayerSettings {
     pub body_enabled: bool,
 }
 
+impl BowedPlayerSettings {
+    /// Ranges the engine clamps to (`EngineSettings::clamped`): vibrato rate, Hz; pitch-bend
+    /// range, semitones (MPE's 48 at most); bow lift time, s.
+    pub const VIBRATO_RATE_RANGE_HZ: (f64, f64) = (0.0, 20.0);
+    pub const PITCH_BEND_RANGE_SEMITONES: (f64, f64) = (0.0, 48.0);
+    pub const BOW_LIFT_TIME_RANGE_S: (f64, f64) = (1e-4, 10.0);
+}
+
 impl Default for BowedPlayerSettings {
     fn default() -> Self {
         Self {

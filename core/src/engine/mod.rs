@@ -18,7 +18,12 @@
 //! - sample-accurate events: [`Engine::process`] splits the block at every event, control tick
 //!   and drone pluck. All of these sit at absolute sample times, so the output does not depend on
 //!   the block size;
-//! - the output level: see [`NEWTONS_AT_FULL_SCALE`].
+//! - the output level: see [`NEWTONS_AT_FULL_SCALE`];
+//! - the boundary with the host: settings pass through [`EngineSettings::clamped`] and events
+//!   through [`EngineEvent::sanitised`], so a non-finite or out-of-range value from automation
+//!   or MIDI is clamped (NaN takes the default) before it reaches a string;
+//! - the output latency a host must compensate ([`Engine::latency_samples`]): the FD tiers'
+//!   decimator delay, none for the modal tiers and the bowed string.
 //!
 //! Lifecycle (design.md): [`Engine::new`] allocates every voice; [`Engine::process`],
 //! [`Engine::set_settings`], [`Engine::set_host_tempo`] and [`Engine::reset`] never allocate,
@@ -146,6 +151,102 @@ impl Default for EngineSettings {
     }
 }
 
+/// `value` within `range`; NaN becomes `fallback` (±∞ clamps to the nearer end).
+fn clamp_or(value: f64, (min, max): (f64, f64), fallback: f64) -> f64 {
+    if value.is_nan() {
+        fallback
+    } else {
+        value.clamp(min, max)
+    }
+}
+
+impl EngineSettings {
+    /// The nearest valid settings: every number within its documented range, NaN replaced by
+    /// the default. What the engine applies, so that whatever a host sends (a NaN from broken
+    /// automation, a value far outside a range from a foreign state) reaches no string.
+    pub fn clamped(&self) -> Self {
+        use preset::{
+            BOW_GLIDE_RANGE_S, BOW_POSITION_RANGE, BOW_VELOCITY_RANGE_M_S, BOW_VIBRATO_RANGE_CENTS,
+            PLUCK_POSITION_RANGE_M,
+        };
+        let default = Self::default();
+        let (pluck, bowed, player) = (self.pluck, self.bowed, self.bowed.player);
+        let default_player = default.bowed.player;
+        Self {
+            voice: self.voice.clamped(),
+            pluck: Pluck {
+                position_m: clamp_or(
+                    pluck.position_m,
+                    PLUCK_POSITION_RANGE_M,
+                    default.pluck.position_m,
+                ),
+                width_m: clamp_or(pluck.width_m, Pluck::WIDTH_RANGE_M, default.pluck.width_m),
+                amplitude_m: clamp_or(
+                    pluck.amplitude_m,
+                    Pluck::AMPLITUDE_RANGE_M,
+                    default.pluck.amplitude_m,
+                ),
+            },
+            output_gain_db: clamp_or(
+                self.output_gain_db,
+                OUTPUT_GAIN_RANGE_DB,
+                default.output_gain_db,
+            ),
+            drone: DroneSettings {
+                free_tempo_bpm: clamp_or(
+                    self.drone.free_tempo_bpm,
+                    drone::TEMPO_RANGE_BPM,
+                    default.drone.free_tempo_bpm,
+                ),
+                ..self.drone
+            },
+            instrument: self.instrument,
+            bowed: BowedEngineSettings {
+                player: BowedPlayerSettings {
+                    glide_time_s: clamp_or(
+                        player.glide_time_s,
+                        BOW_GLIDE_RANGE_S,
+                        default_player.glide_time_s,
+                    ),
+                    vibrato_rate_hz: clamp_or(
+                        player.vibrato_rate_hz,
+                        BowedPlayerSettings::VIBRATO_RATE_RANGE_HZ,
+                        default_player.vibrato_rate_hz,
+                    ),
+                    max_vibrato_cents: clamp_or(
+                        player.max_vibrato_cents,
+                        BOW_VIBRATO_RANGE_CENTS,
+                        default_player.max_vibrato_cents,
+                    ),
+                    pitch_bend_range_semitones: clamp_or(
+                        player.pitch_bend_range_semitones,
+                        BowedPlayerSettings::PITCH_BEND_RANGE_SEMITONES,
+                        default_player.pitch_bend_range_semitones,
+                    ),
+                    bow_lift_time_s: clamp_or(
+                        player.bow_lift_time_s,
+                        BowedPlayerSettings::BOW_LIFT_TIME_RANGE_S,
+                        default_player.bow_lift_time_s,
+                    ),
+                    ..player
+                },
+                pressure: clamp_or(bowed.pressure, (0.0, 1.0), default.bowed.pressure),
+                bow_velocity_m_s: clamp_or(
+                    bowed.bow_velocity_m_s,
+                    BOW_VELOCITY_RANGE_M_S,
+                    default.bowed.bow_velocity_m_s,
+                ),
+                bow_position: clamp_or(
+                    bowed.bow_position,
+                    BOW_POSITION_RANGE,
+                    default.bowed.bow_position,
+                ),
+                ..bowed
+            },
+        }
+    }
+}
+
 /// A musical event.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum EngineEvent {
@@ -165,6 +266,36 @@ pub enum EngineEvent {
     PolyPressure { note: u8, value: f32 },
     /// Pitch bend, −1 to 1.
     PitchBend(f32),
+}
+
+impl EngineEvent {
+    /// The event with its value inside its documented range, or `None` when the value is not a
+    /// number at all (NaN or ±∞ say nothing about what the player meant, so the event is
+    /// dropped rather than guessed).
+    pub fn sanitised(self) -> Option<Self> {
+        let unit = |value: f32| value.is_finite().then(|| value.clamp(0.0, 1.0));
+        Some(match self {
+            EngineEvent::NoteOn { note, velocity } => EngineEvent::NoteOn {
+                note,
+                velocity: unit(velocity)?,
+            },
+            EngineEvent::Controller { number, value } => EngineEvent::Controller {
+                number,
+                value: unit(value)?,
+            },
+            EngineEvent::ChannelPressure(value) => EngineEvent::ChannelPressure(unit(value)?),
+            EngineEvent::PolyPressure { note, value } => EngineEvent::PolyPressure {
+                note,
+                value: unit(value)?,
+            },
+            EngineEvent::PitchBend(value) => {
+                EngineEvent::PitchBend(value.is_finite().then(|| value.clamp(-1.0, 1.0))?)
+            }
+            EngineEvent::NoteOff { .. } | EngineEvent::AllNotesOff | EngineEvent::AllSoundOff => {
+                self
+            }
+        })
+    }
 }
 
 /// An event at a sample offset within the block passed to [`Engine::process`].
@@ -297,7 +428,8 @@ fn db_to_amplitude(db: f64) -> f64 {
 impl Engine {
     /// An engine with `voice_count` strings (at least 1) at `sample_rate_hz`. Allocates.
     pub fn new(settings: &EngineSettings, sample_rate_hz: f64, voice_count: usize) -> Self {
-        let voice = settings.voice.clamped();
+        let settings = &settings.clamped();
+        let voice = settings.voice;
         let slots = (0..voice_count.max(1))
             .map(|_| Slot {
                 voice: TanpuraVoice::new(&voice, sample_rate_hz),
@@ -311,7 +443,7 @@ impl Engine {
         let control_steps =
             (SMOOTHING_TIME_S * sample_rate_hz / CONTROL_INTERVAL as f64).ceil() as u32;
         let gain_steps = (SMOOTHING_TIME_S * sample_rate_hz).ceil() as u32;
-        let gain = db_to_amplitude(Self::clamp_gain_db(settings.output_gain_db));
+        let gain = db_to_amplitude(settings.output_gain_db);
         let mut engine = Self {
             sample_rate_hz,
             slots,
@@ -344,7 +476,6 @@ impl Engine {
             applied_bow_controls: None,
             scratch: Vec::new(),
         };
-        engine.target.voice = voice;
         engine.apply_bowed_settings();
         engine
     }
@@ -409,14 +540,6 @@ impl Engine {
         };
     }
 
-    fn clamp_gain_db(db: f64) -> f64 {
-        if db.is_nan() {
-            0.0
-        } else {
-            db.clamp(OUTPUT_GAIN_RANGE_DB.0, OUTPUT_GAIN_RANGE_DB.1)
-        }
-    }
-
     pub fn sample_rate_hz(&self) -> f64 {
         self.sample_rate_hz
     }
@@ -446,9 +569,8 @@ impl Engine {
     /// there over [`SMOOTHING_TIME_S`]; switches and quality apply at the next control tick; the
     /// pluck applies from the next pluck. Allocation-free; out-of-range values are clamped.
     pub fn set_settings(&mut self, settings: &EngineSettings) {
-        let voice = settings.voice.clamped();
-        self.target = *settings;
-        self.target.voice = voice;
+        self.target = settings.clamped();
+        let voice = self.target.voice;
         self.bridge_stiffness_log
             .set_target(stiffness_to_log(voice.bridge_stiffness_n_m2));
         self.thread_position.set_target(voice.thread_position_m);
@@ -456,14 +578,25 @@ impl Engine {
         self.eta.set_target(voice.eta_s);
         self.pickup_weight.set_target(voice.nut_pickup_weight);
         self.output_gain
-            .set_target(db_to_amplitude(Self::clamp_gain_db(
-                settings.output_gain_db,
-            )));
+            .set_target(db_to_amplitude(self.target.output_gain_db));
         self.apply_bowed_settings();
     }
 
+    /// The settings being applied (after [`EngineSettings::clamped`]).
     pub fn settings(&self) -> &EngineSettings {
         &self.target
+    }
+
+    /// The output latency of the current settings, samples at the output rate: the decimator's
+    /// delay at an FD tier, 0 at a modal tier and for the bowed string. (A string still ringing
+    /// at its old tier after a switch keeps that tier's delay until its next pluck.)
+    pub fn latency_samples(&self) -> f64 {
+        match self.target.instrument {
+            Instrument::Bowed => 0.0,
+            Instrument::Tanpura => self.slots[0]
+                .voice
+                .latency_samples_at(self.target.voice.quality),
+        }
     }
 
     /// The host's tempo for the drone, beats per minute (None when the host reports none).
@@ -482,9 +615,7 @@ impl Engine {
         self.eta.jump_to(voice.eta_s);
         self.pickup_weight.jump_to(voice.nut_pickup_weight);
         self.output_gain
-            .jump_to(db_to_amplitude(Self::clamp_gain_db(
-                self.target.output_gain_db,
-            )));
+            .jump_to(db_to_amplitude(self.target.output_gain_db));
         self.current_voice = voice;
         for slot in &mut self.slots {
             slot.voice.reset();
@@ -668,6 +799,9 @@ impl Engine {
     }
 
     fn handle_event(&mut self, event: EngineEvent) {
+        let Some(event) = event.sanitised() else {
+            return;
+        };
         if self.target.instrument == Instrument::Bowed {
             self.handle_bowed_event(event);
             return;

@@ -63,6 +63,9 @@ pub const BOW_MODEL_NAMES: [&str; 2] = ["rounded-corner", "bow-table"];
 pub const BOW_STRING_NAMES: [&str; 2] = ["violin-a", "cello-d"];
 pub const BOW_VELOCITY_RANGE_M_S: (f64, f64) = (0.02, 1.0);
 pub const BOW_POSITION_RANGE: (f64, f64) = (0.02, 0.5);
+/// Legato glide time, s, and vibrato depth at full modulation, cents.
+pub const BOW_GLIDE_RANGE_S: (f64, f64) = (0.0, 1.0);
+pub const BOW_VIBRATO_RANGE_CENTS: (f64, f64) = (0.0, 100.0);
 
 /// Names of the first drone string's choices, as written in presets.
 pub const FIRST_STRING_NAMES: [&str; 3] = ["pa", "ma", "ni"];
@@ -160,8 +163,8 @@ const KEYS: [(&str, Kind); 26] = [
     ("bow_pressure", Kind::Number((0.0, 1.0))),
     ("bow_velocity_m_s", Kind::Number(BOW_VELOCITY_RANGE_M_S)),
     ("bow_position", Kind::Number(BOW_POSITION_RANGE)),
-    ("bow_glide_s", Kind::Number((0.0, 1.0))),
-    ("bow_vibrato_cents", Kind::Number((0.0, 100.0))),
+    ("bow_glide_s", Kind::Number(BOW_GLIDE_RANGE_S)),
+    ("bow_vibrato_cents", Kind::Number(BOW_VIBRATO_RANGE_CENTS)),
     ("bow_body", Kind::Switch),
 ];
 

@@ -596,7 +596,13 @@ impl TanpuraVoice {
     /// Output latency, samples at the output rate: the decimation filter's delay for the FD
     /// tiers, none for the modal tiers.
     pub fn latency_samples(&self) -> f64 {
-        match self.oversample() {
+        self.latency_samples_at(self.settings.quality)
+    }
+
+    /// The output latency this voice has at `quality` (its decimators are built for every
+    /// oversampling factor up front), samples at the output rate.
+    pub fn latency_samples_at(&self, quality: Quality) -> f64 {
+        match quality.oversample() {
             1 => 0.0,
             oversample => self.decimators[oversample - 1].delay_output_samples(),
         }
