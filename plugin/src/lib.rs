@@ -13,11 +13,19 @@
 //! With the `inst` parameter on Bowed, the same events play one bowed string
 //! (`javari_core::bowed::instrument` documents that mapping): CCs, channel and per-note pressure
 //! and pitch bend reach it too.
+//!
+//! Towards the host: the latency of the current quality tier (the FD tiers' decimator delay,
+//! none for the modal tiers) is reported at activation and again from `process` whenever the tier
+//! changes (nice-plug passes that on as CLAP `latency.changed` after a restart, VST3
+//! `restartComponent(kLatencyChanged)`); a state blob is repaired before it loads ([`state`]);
+//! `process` runs with subnormals flushed to zero (`javari_core::denormals`).
 
 pub mod editor;
 pub mod params;
+pub mod state;
 
 use editor::channel::{SnapshotChannel, SnapshotPublisher, QUEUE_FRAMES};
+use javari_core::denormals::FlushDenormals;
 use javari_core::engine::preset::Preset;
 use javari_core::engine::render::DEFAULT_VOICE_COUNT;
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
@@ -69,6 +77,11 @@ pub fn factory_presets() -> [Preset; params::FACTORY_PRESET_COUNT] {
             settings: EngineSettings::default(),
         })
     })
+}
+
+/// The engine's latency as the host takes it: whole samples at the output rate.
+fn latency_in_samples(engine: &Engine) -> u32 {
+    engine.latency_samples().round() as u32
 }
 
 /// Most note events handled in one block (the wrapper's own queue holds as many).
@@ -124,6 +137,10 @@ impl Plugin for Javari {
         self.params.clone()
     }
 
+    fn filter_state(state: &mut PluginState) {
+        state::repair(state);
+    }
+
     fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
         editor::create(
             self.params.clone(),
@@ -136,17 +153,19 @@ impl Plugin for Javari {
         &mut self,
         _audio_io_layout: &AudioIOLayout,
         buffer_config: &BufferConfig,
-        _context: &mut impl ActivateContext<Self>,
+        context: &mut impl ActivateContext<Self>,
     ) -> bool {
         let settings = self.params.engine_settings(&self.factory);
         let rate = f64::from(buffer_config.sample_rate);
-        let rebuild = self
-            .engine
-            .as_ref()
-            .is_none_or(|engine| engine.sample_rate_hz() != rate);
-        if rebuild {
-            self.engine = Some(Engine::new(&settings, rate, DEFAULT_VOICE_COUNT));
-        }
+        let engine = match self.engine.take() {
+            Some(mut engine) if engine.sample_rate_hz() == rate => {
+                engine.set_settings(&settings);
+                engine
+            }
+            _ => Engine::new(&settings, rate, DEFAULT_VOICE_COUNT),
+        };
+        context.set_latency_samples(latency_in_samples(&engine));
+        self.engine = Some(engine);
         self.snapshots.prepare(rate);
         self.mono
             .resize(buffer_config.max_buffer_size.max(1) as usize, 0.0);
@@ -168,10 +187,13 @@ impl Plugin for Javari {
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
         let started = Instant::now();
+        let _flush_denormals = FlushDenormals::enable();
         let Some(engine) = &mut self.engine else {
             return ProcessStatus::Error("process called before activate");
         };
         engine.set_settings(&self.params.engine_settings(&self.factory));
+        // The wrapper tells the host only when the value changes (a change of tier).
+        context.set_latency_samples(latency_in_samples(engine));
         engine.set_host_tempo(context.transport().tempo);
 
         self.events.clear();
