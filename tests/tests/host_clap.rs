@@ -1,30 +1,66 @@
 //! The built `.clap` (the `javari` cdylib that `cargo test` leaves in `target/<profile>/deps/`)
 //! loaded by a CLAP host written with `clack-host`, as a DAW would: activate at several sample
 //! rates and block sizes, play a note, check the pitch while it rings and that every sample is
-//! finite, and round-trip the plugin state. The cdylib is built with `assert_process_allocs`,
-//! so an allocation in `process` aborts this test.
+//! finite, and round-trip the plugin state. The host offers the latency extension and records
+//! restart requests and `latency.changed` calls, so the latency the plugin reports per quality
+//! tier, and its changes, are checked as a DAW would see them. Corrupt, foreign and out-of-range
+//! state blobs must load the defaults (or be refused, leaving them) and never crash the host.
+//! The cdylib is built with `assert_process_allocs`, so an allocation in `process` aborts this
+//! test.
 
+use clack_extensions::latency::{HostLatency, HostLatencyImpl, PluginLatency};
 use clack_extensions::params::{ParamInfoBuffer, PluginParams};
 use clack_extensions::state::PluginState;
 use clack_host::events::event_types::{NoteOnEvent, ParamValueEvent};
 use clack_host::prelude::*;
 use javari_core::engine::pitch::{cents, note_to_hz};
+use javari_core::engine::{Engine, EngineSettings};
+use javari_core::tanpura::quality::Quality;
 use javari_tests::{peak, peak_frequency_near, plugin_library};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, Ordering};
 
-struct TestHostShared;
+/// Requests the plugin makes from any thread, remembered until the test looks.
+#[derive(Default)]
+struct TestHostShared {
+    restart_requested: AtomicBool,
+    callback_requested: AtomicBool,
+}
 
 impl SharedHandler<'_> for TestHostShared {
-    fn request_restart(&self) {}
+    fn request_restart(&self) {
+        self.restart_requested.store(true, Ordering::SeqCst);
+    }
     fn request_process(&self) {}
-    fn request_callback(&self) {}
+    fn request_callback(&self) {
+        self.callback_requested.store(true, Ordering::SeqCst);
+    }
+}
+
+/// Main-thread callbacks: how often the plugin said its latency changed.
+#[derive(Default)]
+struct TestHostMainThread {
+    latency_changes: Cell<u32>,
+}
+
+impl MainThreadHandler<'_> for TestHostMainThread {}
+
+impl HostLatencyImpl for TestHostMainThread {
+    fn changed(&self) {
+        self.latency_changes.set(self.latency_changes.get() + 1);
+    }
 }
 
 struct TestHost;
 
 impl HostHandlers for TestHost {
     type Shared<'a> = TestHostShared;
-    type MainThread<'a> = ();
+    type MainThread<'a> = TestHostMainThread;
     type AudioProcessor<'a> = ();
+
+    fn declare_extensions(builder: &mut HostExtensions<Self>, _shared: &Self::Shared<'_>) {
+        builder.register::<HostLatency>();
+    }
 }
 
 const PLUGIN_ID: &[u8] = b"org.javari.tanpura";
@@ -52,8 +88,14 @@ fn instantiate(entry: &PluginEntry) -> PluginInstance<TestHost> {
         .expect("the Javari descriptor");
     assert_eq!(descriptor.name().unwrap().to_bytes(), b"Javari");
     let id = descriptor.id().unwrap();
-    PluginInstance::<TestHost>::new(|_| TestHostShared, |_| (), entry, id, &host_info)
-        .expect("instantiation")
+    PluginInstance::<TestHost>::new(
+        |_| TestHostShared::default(),
+        |_| TestHostMainThread::default(),
+        entry,
+        id,
+        &host_info,
+    )
+    .expect("instantiation")
 }
 
 /// Plays `key` at `velocity` from sample `note_at` for `seconds`, in blocks of `block_size`;
@@ -155,6 +197,11 @@ fn play_automated(
     }
     let processor = processor.stop_processing();
     instance.deactivate(processor);
+    // What a host's main loop does: run the callback the plugin asked for.
+    if instance.access_shared_handler(|host| host.callback_requested.swap(false, Ordering::SeqCst))
+    {
+        instance.call_on_main_thread_callback();
+    }
     (left, right)
 }
 
@@ -327,4 +374,223 @@ fn parameter_value(text: &str, id: &str) -> f64 {
 fn edit_parameter(text: &str, id: &str, value: f64) -> String {
     let (start, end) = parameter_span(text, id);
     format!("{}{value}{}", &text[..start], &text[end..])
+}
+
+/// The latency the engine has at `quality`, in whole samples at 44.1 kHz.
+fn engine_latency(quality: Quality) -> u32 {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = quality;
+    Engine::new(&settings, 44_100.0, 1)
+        .latency_samples()
+        .round() as u32
+}
+
+/// The plugin reports 0 samples at the modal tiers and the decimator's delay at the FD tiers.
+/// Automating the tier while processing asks the host for a restart; on reactivation the
+/// plugin calls `latency.changed`, and `latency.get` returns the new tier's latency.
+#[test]
+fn clap_reports_the_tier_latency_and_its_changes() {
+    let entry = load_entry();
+    let mut instance = instantiate(entry);
+    let quality = parameter_id(&mut instance, "Quality");
+    let latency = instance
+        .plugin_handle()
+        .get_extension::<PluginLatency>()
+        .expect("the latency extension");
+    let restart_requested = |instance: &PluginInstance<TestHost>| {
+        instance.access_shared_handler(|host| host.restart_requested.swap(false, Ordering::SeqCst))
+    };
+    let changes = |instance: &PluginInstance<TestHost>| {
+        instance.access_handler(|host| host.latency_changes.get())
+    };
+
+    let studio = engine_latency(Quality::Studio);
+    let reference = engine_latency(Quality::Reference);
+    println!("latency: studio {studio} samples, reference {reference} samples at 44.1 kHz");
+    assert!(
+        studio > 0 && reference > 0,
+        "the FD tiers have a decimator delay"
+    );
+    assert_eq!(engine_latency(Quality::Live), 0);
+
+    let rate = 44_100.0;
+    play(&mut instance, rate, 64, 57, 0.5, 0, 0.02);
+    assert_eq!(
+        latency.get(&instance.plugin_handle()),
+        0,
+        "live, the default"
+    );
+    assert!(!restart_requested(&instance));
+    assert_eq!(changes(&instance), 0);
+
+    // (CLAP plain value of an enum parameter: its index. Draft 0, live 1, studio 2, reference 3.)
+    // A change of tier that keeps the latency (studio and reference both decimate to about the
+    // same delay) asks for nothing.
+    let mut reported = 0;
+    let mut expected_changes = 0;
+    for (index, expected) in [
+        (2.0, studio),
+        (3.0, reference),
+        (1.0, 0),
+        (0.0, 0),
+        (3.0, reference),
+    ] {
+        play_automated(
+            &mut instance,
+            rate,
+            64,
+            (57, 0.5, 0),
+            &[(100, quality, index)],
+            0.02,
+        );
+        let changed = expected != reported;
+        assert_eq!(
+            restart_requested(&instance),
+            changed,
+            "tier {index}: restart request"
+        );
+        // The host restarts the plugin: the reactivation reports the change.
+        play(&mut instance, rate, 64, 57, 0.5, 0, 0.02);
+        expected_changes += u32::from(changed);
+        assert_eq!(
+            changes(&instance),
+            expected_changes,
+            "tier {index}: latency.changed"
+        );
+        assert_eq!(
+            latency.get(&instance.plugin_handle()),
+            expected,
+            "tier {index}"
+        );
+        assert!(
+            !restart_requested(&instance),
+            "tier {index}: no further restart"
+        );
+        reported = expected;
+    }
+    assert_eq!(expected_changes, 3);
+}
+
+/// Blobs a host might hand over that are not a Javari state: the load is refused or repaired,
+/// never a crash, and a fresh instance given one still saves (and plays) its defaults.
+#[test]
+fn clap_corrupt_or_foreign_state_loads_the_defaults() {
+    let entry = load_entry();
+    let mut fresh = instantiate(entry);
+    let defaults = save_state(&mut fresh);
+    let mut blobs: Vec<(&str, Vec<u8>)> = vec![
+        ("empty", Vec::new()),
+        ("shorter than the length prefix", vec![1, 2, 3]),
+        ("huge length prefix", u64::MAX.to_le_bytes().to_vec()),
+        ("length prefix past the end", {
+            let mut bytes = 100u64.to_le_bytes().to_vec();
+            bytes.extend_from_slice(b"{}");
+            bytes
+        }),
+        (
+            "bytes that are not JSON",
+            state_bytes("\u{0}\u{1}garbage\u{ff}"),
+        ),
+        (
+            "JSON of another shape",
+            state_bytes(r#"{"presets":[1,2,3]}"#),
+        ),
+        (
+            "truncated state",
+            state_bytes(&defaults[..defaults.len() / 2]),
+        ),
+        (
+            "another plugin's state",
+            state_bytes(r#"{"version":"2.1","params":{"cutoff":{"f32":880.0}},"fields":{}}"#),
+        ),
+    ];
+    let pseudo_random: Vec<u8> = (0u32..4096)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+        .collect();
+    blobs.push(("pseudo-random bytes", pseudo_random));
+    for (what, blob) in &blobs {
+        let mut instance = instantiate(entry);
+        let loaded = load_state(&mut instance, blob);
+        assert_eq!(save_state(&mut instance), defaults, "{what}: defaults");
+        let (left, _) = play(&mut instance, 44_100.0, 256, 57, 0.5, 0, 0.1);
+        assert!(left.iter().all(|x| x.is_finite()), "{what}");
+        assert!(peak(&left) > 1e-3, "{what}: plays");
+        println!(
+            "{what}: load {}",
+            if loaded { "accepted" } else { "refused" }
+        );
+    }
+
+    // A foreign state over an edited instance brings every parameter back to its default.
+    let mut edited = instantiate(entry);
+    assert!(load_state(
+        &mut edited,
+        &state_bytes(&edit_parameter(&defaults, "gain", -12.0))
+    ));
+    assert_eq!(parameter_value(&save_state(&mut edited), "gain"), -12.0);
+    assert!(load_state(
+        &mut edited,
+        &state_bytes(r#"{"params":{"x":{"bool":true}},"fields":{}}"#)
+    ));
+    assert_eq!(save_state(&mut edited), defaults, "foreign state: defaults");
+
+    // Out-of-range numbers (what an edited file or another version might hold) are clamped, and
+    // the state saved afterwards loads again.
+    let mut clamped = instantiate(entry);
+    let wild = edit_parameter(&edit_parameter(&defaults, "gain", 1e39), "kb", -1e30);
+    assert!(load_state(&mut clamped, &state_bytes(&wild)));
+    let saved = save_state(&mut clamped);
+    assert_eq!(parameter_value(&saved, "gain"), 24.0);
+    assert_eq!(parameter_value(&saved, "kb"), 5.0);
+    let mut reloaded = instantiate(entry);
+    assert!(load_state(&mut reloaded, &state_bytes(&saved)));
+    assert_eq!(save_state(&mut reloaded), saved);
+}
+
+/// Non-finite and out-of-range automation: the wrapper refuses the first and clamps the
+/// second to the parameter's range; the output stays finite.
+#[test]
+fn clap_non_finite_and_out_of_range_automation_is_clamped() {
+    let entry = load_entry();
+    let mut instance = instantiate(entry);
+    let gain = parameter_id(&mut instance, "Output gain");
+    let stiffness = parameter_id(&mut instance, "Bridge stiffness");
+    let damping = parameter_id(&mut instance, "Damping");
+    let automation = [
+        (1_000, gain, f64::NAN),
+        (1_100, stiffness, f64::INFINITY),
+        (1_200, damping, f64::NEG_INFINITY),
+        (2_000, gain, 1e300),
+        (2_100, stiffness, -1e300),
+        (2_200, damping, 1e30),
+    ];
+    let (left, _) = play_automated(&mut instance, 44_100.0, 128, (57, 0.5, 0), &automation, 0.3);
+    assert!(left.iter().all(|x| x.is_finite()), "non-finite sample");
+    let saved = save_state(&mut instance);
+    assert_eq!(parameter_value(&saved, "gain"), 24.0, "clamped to the top");
+    assert_eq!(parameter_value(&saved, "kb"), 5.0, "clamped to the bottom");
+    assert_eq!(parameter_value(&saved, "gamma"), 20.0, "clamped to the top");
+}
+
+fn save_state(instance: &mut PluginInstance<TestHost>) -> String {
+    let extension = instance
+        .plugin_handle()
+        .get_extension::<PluginState>()
+        .expect("the state extension");
+    let mut saved = Vec::new();
+    extension
+        .save(&instance.plugin_handle(), &mut saved)
+        .expect("save");
+    state_json(&saved)
+}
+
+/// Loads `bytes` as the host's state; whether the plugin accepted it.
+fn load_state(instance: &mut PluginInstance<TestHost>, bytes: &[u8]) -> bool {
+    let extension = instance
+        .plugin_handle()
+        .get_extension::<PluginState>()
+        .expect("the state extension");
+    extension
+        .load(&instance.plugin_handle(), &mut &bytes[..])
+        .is_ok()
 }
