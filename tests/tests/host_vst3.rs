@@ -1,19 +1,27 @@
 //! The built plugin library loaded through its VST3 entry points with the `vst3` crate's
 //! bindings, as a VST3 host would: `ModuleEntry`, `GetPluginFactory`, the audio-module class,
 //! `IComponent` + `IAudioProcessor`, bus activation, `setupProcessing`, notes through an
-//! `IEventList`, and the state through an `IBStream`. The library is the same cdylib the CLAP
-//! test loads (with `assert_process_allocs`), the one `cargo xtask bundle` copies into
+//! `IEventList`, and the state through an `IBStream`. The host also hands the edit controller an
+//! `IComponentHandler` that records `restartComponent` flags, so the latency the plugin reports
+//! (`getLatencySamples`) per quality tier and its `kLatencyChanged` restarts are checked; corrupt,
+//! foreign and out-of-range state blobs must load the defaults (or be refused, leaving them) and
+//! never crash the host. The library is the same cdylib the CLAP test loads (with
+//! `assert_process_allocs`), the one `cargo xtask bundle` copies into
 //! `javari.vst3/Contents/x86_64-linux/`.
 
 use javari_core::engine::pitch::{cents, note_to_hz};
+use javari_core::engine::{Engine, EngineSettings};
+use javari_core::tanpura::quality::Quality;
 use javari_tests::{peak, peak_frequency_near, plugin_library};
 use std::cell::RefCell;
 use std::ffi::{c_void, CStr};
+use std::sync::atomic::{AtomicI32, Ordering};
 use vst3::Steinberg::Vst::{
     AudioBusBuffers, AudioBusBuffers__type0, BusDirections_, Event, Event_, Event__type0,
-    IAudioProcessor, IAudioProcessorTrait, IComponent, IComponentTrait, IEventList,
-    IEventListTrait, MediaTypes_, NoteOnEvent, ProcessData, ProcessModes_, ProcessSetup,
-    SymbolicSampleSizes_,
+    IAudioProcessor, IAudioProcessorTrait, IComponent, IComponentHandler, IComponentHandlerTrait,
+    IComponentTrait, IEditController, IEditControllerTrait, IEventList, IEventListTrait,
+    MediaTypes_, NoteOnEvent, ParamID, ParamValue, ParameterInfo, ProcessData, ProcessModes_,
+    ProcessSetup, RestartFlags_, SymbolicSampleSizes_,
 };
 use vst3::Steinberg::{
     int32, int64, kInvalidArgument, kResultFalse, kResultOk, tresult, IBStream, IBStreamTrait,
@@ -47,6 +55,36 @@ impl IEventListTrait for EventList {
 
     unsafe fn addEvent(&self, _event: *mut Event) -> tresult {
         kResultFalse
+    }
+}
+
+/// The host side of the edit controller: parameter edits are ignored, restart requests are
+/// recorded (the flags of every `restartComponent` call, OR-ed, until the test takes them).
+#[derive(Default)]
+struct ComponentHandler {
+    restart_flags: AtomicI32,
+}
+
+impl Class for ComponentHandler {
+    type Interfaces = (IComponentHandler,);
+}
+
+impl IComponentHandlerTrait for ComponentHandler {
+    unsafe fn beginEdit(&self, _id: ParamID) -> tresult {
+        kResultOk
+    }
+
+    unsafe fn performEdit(&self, _id: ParamID, _value: ParamValue) -> tresult {
+        kResultOk
+    }
+
+    unsafe fn endEdit(&self, _id: ParamID) -> tresult {
+        kResultOk
+    }
+
+    unsafe fn restartComponent(&self, flags: int32) -> tresult {
+        self.restart_flags.fetch_or(flags, Ordering::SeqCst);
+        kResultOk
     }
 }
 
@@ -217,6 +255,30 @@ fn play(
     note_at: usize,
     seconds: f64,
 ) -> (Vec<f32>, Vec<f32>) {
+    play_automated(
+        component,
+        processor,
+        (sample_rate, block_size),
+        (key, note_at),
+        &[],
+        seconds,
+    )
+}
+
+/// As [`play`], with parameter changes `(sample, parameter ID, normalised value)` made through
+/// the edit controller before the block holding the sample, as a host's editor thread would
+/// between blocks (processing paused, since nice-plug takes `setParamNormalized` only then).
+fn play_automated(
+    component: &ComPtr<IComponent>,
+    processor: &ComPtr<IAudioProcessor>,
+    (sample_rate, block_size): (f64, usize),
+    (key, note_at): (i16, usize),
+    automation: &[(usize, ParamID, f64)],
+    seconds: f64,
+) -> (Vec<f32>, Vec<f32>) {
+    let controller = component
+        .cast::<IEditController>()
+        .expect("IEditController on the component");
     unsafe {
         let audio = MediaTypes_::kAudio as i32;
         let event = MediaTypes_::kEvent as i32;
@@ -243,6 +305,14 @@ fn play(
         let mut start = 0;
         while start < total {
             let frames = block_size.min(total - start);
+            let block = start..start + frames;
+            if automation.iter().any(|(at, ..)| block.contains(at)) {
+                processor.setProcessing(0);
+                for &(_, id, value) in automation.iter().filter(|(at, ..)| block.contains(at)) {
+                    controller.setParamNormalized(id, value);
+                }
+                processor.setProcessing(1);
+            }
             let events = if (start..start + frames).contains(&note_at) {
                 vec![note_on((note_at - start) as i32, key, 0.4)]
             } else {
@@ -362,5 +432,220 @@ fn vst3_state_round_trip() {
     unsafe {
         first.terminate();
         second.terminate();
+    }
+}
+
+/// The latency the engine has at `quality`, in whole samples at 44.1 kHz.
+fn engine_latency(quality: Quality) -> u32 {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = quality;
+    Engine::new(&settings, 44_100.0, 1)
+        .latency_samples()
+        .round() as u32
+}
+
+/// The ID of the parameter titled `title`.
+fn parameter_id(component: &ComPtr<IComponent>, title: &str) -> ParamID {
+    let controller = component.cast::<IEditController>().unwrap();
+    unsafe {
+        (0..controller.getParameterCount())
+            .find_map(|index| {
+                let mut info: ParameterInfo = std::mem::zeroed();
+                controller.getParameterInfo(index, &mut info);
+                let end = info.title.iter().position(|c| *c == 0).unwrap_or(128);
+                (String::from_utf16_lossy(&info.title[..end]) == title).then_some(info.id)
+            })
+            .unwrap_or_else(|| panic!("no parameter titled {title}"))
+    }
+}
+
+/// The plugin reports 0 samples at the modal tiers and the decimator's delay at the FD tiers,
+/// and asks the host to restart with `kLatencyChanged` when automation changes the tier's
+/// latency while it processes.
+#[test]
+fn vst3_reports_the_tier_latency_and_its_changes() {
+    let module = module();
+    let (component, processor) = module.instantiate();
+    let handler = ComWrapper::new(ComponentHandler::default());
+    let controller = component.cast::<IEditController>().unwrap();
+    unsafe {
+        let handler_pointer = handler.to_com_ptr::<IComponentHandler>().unwrap();
+        assert_eq!(
+            controller.setComponentHandler(handler_pointer.as_ptr()),
+            kResultOk
+        );
+    }
+    let quality = parameter_id(&component, "Quality");
+    let take_restart_flags = || handler.restart_flags.swap(0, Ordering::SeqCst);
+    let latency = || unsafe { processor.getLatencySamples() };
+
+    play(&component, &processor, 44_100.0, 64, 57, 0, 0.02);
+    assert_eq!(latency(), 0, "live, the default");
+    assert_eq!(take_restart_flags(), 0);
+
+    // Normalised enum values: draft 0, live 1/3, studio 2/3, reference 1.
+    let mut reported = 0;
+    for (tier, value, expected) in [
+        (Quality::Studio, 2.0 / 3.0, engine_latency(Quality::Studio)),
+        (Quality::Live, 1.0 / 3.0, 0),
+        (Quality::Reference, 1.0, engine_latency(Quality::Reference)),
+        (Quality::Draft, 0.0, 0),
+    ] {
+        play_automated(
+            &component,
+            &processor,
+            (44_100.0, 64),
+            (57, 0),
+            &[(640, quality, value)],
+            0.05,
+        );
+        let flags = take_restart_flags();
+        println!(
+            "{tier:?}: latency {} samples, restart flags {flags}",
+            latency()
+        );
+        assert_eq!(latency(), expected, "{tier:?}");
+        assert!(expected > 0 || tier.oversample() == 1, "{tier:?}");
+        let latency_changed = flags & RestartFlags_::kLatencyChanged != 0;
+        assert_eq!(
+            latency_changed,
+            expected != reported,
+            "{tier:?}: flags {flags}"
+        );
+        reported = expected;
+    }
+    unsafe {
+        controller.setComponentHandler(std::ptr::null_mut());
+        component.terminate();
+    }
+}
+
+fn get_state(component: &ComPtr<IComponent>) -> String {
+    let stream = ComWrapper::new(MemoryStream {
+        bytes: RefCell::new(Vec::new()),
+        position: RefCell::new(0),
+    });
+    unsafe {
+        let pointer = stream.to_com_ptr::<IBStream>().unwrap();
+        assert_eq!(component.getState(pointer.as_ptr()), kResultOk);
+    }
+    let bytes = stream.bytes.borrow().clone();
+    String::from_utf8(bytes).expect("JSON state")
+}
+
+/// Loads `bytes` as the state; whether the plugin accepted it.
+fn set_state(component: &ComPtr<IComponent>, bytes: &[u8]) -> bool {
+    let stream = ComWrapper::new(MemoryStream {
+        bytes: RefCell::new(bytes.to_vec()),
+        position: RefCell::new(0),
+    });
+    unsafe {
+        let pointer = stream.to_com_ptr::<IBStream>().unwrap();
+        component.setState(pointer.as_ptr()) == kResultOk
+    }
+}
+
+/// Blobs a host might hand over that are not a Javari state: refused or repaired, never a
+/// crash; a fresh instance given one saves (and plays) its defaults, and a foreign state over
+/// an edited instance brings back every default.
+#[test]
+fn vst3_corrupt_or_foreign_state_loads_the_defaults() {
+    let module = module();
+    let (fresh, _) = module.instantiate();
+    let defaults = get_state(&fresh);
+    let pseudo_random: Vec<u8> = (0u32..4096)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+        .collect();
+    let blobs: [(&str, Vec<u8>); 6] = [
+        ("empty", Vec::new()),
+        ("bytes that are not JSON", b"\x00\x01garbage\xff".to_vec()),
+        ("JSON of another shape", br#"{"presets":[1,2,3]}"#.to_vec()),
+        (
+            "truncated state",
+            defaults.as_bytes()[..defaults.len() / 2].to_vec(),
+        ),
+        (
+            "another plugin's state",
+            br#"{"version":"2.1","params":{"cutoff":{"f32":880.0}},"fields":{}}"#.to_vec(),
+        ),
+        ("pseudo-random bytes", pseudo_random),
+    ];
+    for (what, blob) in &blobs {
+        let (component, processor) = module.instantiate();
+        let accepted = set_state(&component, blob);
+        println!("{what}: {}", if accepted { "accepted" } else { "refused" });
+        assert_eq!(get_state(&component), defaults, "{what}: defaults");
+        let (left, _) = play(&component, &processor, 44_100.0, 256, 57, 0, 0.1);
+        assert!(left.iter().all(|x| x.is_finite()), "{what}");
+        assert!(peak(&left) > 1e-3, "{what}: plays");
+        unsafe {
+            component.terminate();
+        }
+    }
+
+    let (edited, _) = module.instantiate();
+    let quiet = defaults.replace("\"gain\":{\"f32\":0.0}", "\"gain\":{\"f32\":-12.0}");
+    assert!(set_state(&edited, quiet.as_bytes()));
+    assert_eq!(get_state(&edited), quiet);
+    assert!(set_state(
+        &edited,
+        br#"{"params":{"x":{"bool":true}},"fields":{}}"#
+    ));
+    assert_eq!(get_state(&edited), defaults, "foreign state: defaults");
+
+    // Out-of-range numbers are clamped, and the state saved afterwards loads again.
+    let wild = defaults
+        .replace("\"gain\":{\"f32\":0.0}", "\"gain\":{\"f32\":1e39}")
+        .replace("\"kb\":{\"f32\":8.0}", "\"kb\":{\"f32\":-1e30}");
+    assert_ne!(wild, defaults);
+    assert!(set_state(&edited, wild.as_bytes()));
+    let saved = get_state(&edited);
+    assert!(saved.contains("\"gain\":{\"f32\":24.0}"), "{saved}");
+    assert!(saved.contains("\"kb\":{\"f32\":5.0}"), "{saved}");
+    let (reloaded, _) = module.instantiate();
+    assert!(set_state(&reloaded, saved.as_bytes()));
+    assert_eq!(get_state(&reloaded), saved);
+    unsafe {
+        fresh.terminate();
+        edited.terminate();
+        reloaded.terminate();
+    }
+}
+
+/// Non-finite automation is refused and out-of-range automation clamped to the range; the
+/// output stays finite.
+#[test]
+fn vst3_non_finite_and_out_of_range_automation_is_clamped() {
+    let module = module();
+    let (component, processor) = module.instantiate();
+    let gain = parameter_id(&component, "Output gain");
+    let stiffness = parameter_id(&component, "Bridge stiffness");
+    let controller = component.cast::<IEditController>().unwrap();
+    unsafe {
+        assert_ne!(controller.setParamNormalized(gain, f64::NAN), kResultOk);
+        assert_ne!(
+            controller.setParamNormalized(gain, f64::INFINITY),
+            kResultOk
+        );
+        assert_eq!(controller.setParamNormalized(gain, 1e30), kResultOk);
+        assert_eq!(controller.setParamNormalized(stiffness, -1e30), kResultOk);
+        assert_eq!(controller.getParamNormalized(gain), 1.0);
+        assert_eq!(controller.getParamNormalized(stiffness), 0.0);
+    }
+    let automation = [(3_000, gain, f64::NAN), (3_000, stiffness, 1e30)];
+    let (left, _) = play_automated(
+        &component,
+        &processor,
+        (44_100.0, 128),
+        (57, 0),
+        &automation,
+        0.3,
+    );
+    assert!(left.iter().all(|x| x.is_finite()), "non-finite sample");
+    let state = get_state(&component);
+    assert!(state.contains("\"gain\":{\"f32\":24.0}"), "{state}");
+    assert!(state.contains("\"kb\":{\"f32\":11.0}"), "{state}");
+    unsafe {
+        component.terminate();
     }
 }
