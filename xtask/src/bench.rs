@@ -27,8 +27,9 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
 
-const SAMPLE_RATE: f64 = 44_100.0;
-const BLOCK: usize = 64;
+/// The plugin's usual host setting, shared with `cargo xtask soak`: 64-sample blocks at 44.1 kHz.
+pub const SAMPLE_RATE: f64 = 44_100.0;
+pub const BLOCK: usize = 64;
 
 #[derive(Debug, Parser)]
 pub struct BenchArgs {
@@ -184,7 +185,8 @@ impl<V: BowedVoice> Scene for BowedNote<V> {
     }
 }
 
-fn percentile(sorted: &[f64], fraction: f64) -> f64 {
+/// The value at `fraction` (0–1) of a sorted, non-empty slice.
+pub fn percentile(sorted: &[f64], fraction: f64) -> f64 {
     let index = ((sorted.len() as f64 - 1.0) * fraction).round() as usize;
     sorted[index.min(sorted.len() - 1)]
 }

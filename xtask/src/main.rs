@@ -9,12 +9,13 @@ mod bundle;
 mod plot;
 mod render;
 mod simulate;
+mod soak;
 mod stability;
 
 use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
-/// Javari's offline tools: render, bundle, simulate, bench, stability.
+/// Javari's offline tools: render, bundle, simulate, bench, stability, soak.
 #[derive(Debug, Parser)]
 #[command(name = "cargo xtask", bin_name = "cargo xtask")]
 struct Cli {
@@ -36,6 +37,8 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Woodhouse stability analysis: thresholds, eigenvalues, paper sweeps, preset margins.
     Stability(stability::StabilityArgs),
+    /// Simulated hours of play with every parameter automated: block times, allocations, NaNs.
+    Soak(soak::SoakArgs),
 }
 
 /// A command-line error found after parsing (a check that spans several options), reported as
@@ -58,6 +61,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Stability(args) => stability::run(args),
+        Command::Soak(args) => soak::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -79,7 +83,7 @@ mod tests {
 
     #[test]
     fn every_command_has_generated_help() {
-        for command in ["render", "bundle", "simulate", "bench", "stability"] {
+        for command in ["render", "bundle", "simulate", "bench", "stability", "soak"] {
             let error = Cli::try_parse_from(["cargo xtask", command, "--help"]).unwrap_err();
             assert_eq!(
                 error.kind(),
