@@ -45,7 +45,6 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::error::Error;
 use std::io::Write as _;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 #[derive(Debug, Parser)]
@@ -86,14 +85,15 @@ struct CountingAllocator;
 thread_local! {
     /// Set around the engine calls that the plugin makes in `process`.
     static AUDIO_PATH: Cell<bool> = const { Cell::new(false) };
+    /// Allocations this thread made while its flag was set. Per thread, so that another
+    /// thread counting at the same time (tests run in parallel) never shows up here.
+    static AUDIO_PATH_ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
 }
 
-static AUDIO_PATH_ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
-
 fn count_if_on_audio_path() {
-    // `try_with`: a const-initialised `Cell<bool>` needs no lazy set-up, so this never allocates.
+    // `try_with`: const-initialised cells need no lazy set-up, so this never allocates.
     if AUDIO_PATH.try_with(Cell::get).unwrap_or(false) {
-        AUDIO_PATH_ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        let _ = AUDIO_PATH_ALLOCATIONS.try_with(|count| count.set(count.get() + 1));
     }
 }
 
@@ -124,14 +124,11 @@ static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 /// Allocations (and frees) counted on this thread while `body` ran, and its result.
 fn counting_allocations<T>(body: impl FnOnce() -> T) -> (u64, T) {
-    let before = AUDIO_PATH_ALLOCATIONS.load(Ordering::Relaxed);
+    let before = AUDIO_PATH_ALLOCATIONS.with(Cell::get);
     AUDIO_PATH.with(|flag| flag.set(true));
     let result = body();
     AUDIO_PATH.with(|flag| flag.set(false));
-    (
-        AUDIO_PATH_ALLOCATIONS.load(Ordering::Relaxed) - before,
-        result,
-    )
+    (AUDIO_PATH_ALLOCATIONS.with(Cell::get) - before, result)
 }
 
 /// Time of one block, seconds: by the wall clock and by the thread's CPU clock.
