@@ -32,6 +32,7 @@ pub mod lanes;
 pub mod modes;
 pub mod points;
 pub mod solve;
+pub mod step;
 
 use crate::newton::{NewtonSettings, NewtonStats};
 use crate::tanpura::excitation::{finger_height_m, Pluck};
@@ -40,8 +41,9 @@ use crate::tanpura::string::StringParameters;
 use lanes::{Kernels, Real, LANE_PADDING};
 use modes::{ModeSet, AUDIBLE_LIMIT_HZ, MODE_CAPACITY};
 use points::{grid_points, ContactPoints};
-use solve::{linearised_fundamental, ContactStep, StaticSolver};
+use solve::{linearised_fundamental, StaticSolver};
 use std::f64::consts::PI;
+use step::ContactStep;
 
 const _: () = assert!(MODE_CAPACITY.is_multiple_of(LANE_PADDING));
 
@@ -190,8 +192,6 @@ pub struct ModalString<T: Real> {
     /// ‖Ψ_i‖₂ over the kept modes, with a margin for the rounding of the T rows: the bound
     /// `|Ψ_i · s| ≤ ‖Ψ_i‖ ‖s‖` that lets a far point skip its free step.
     shape_norms: Vec<f64>,
-    /// Free steps of the tracked points, in tracked order.
-    tracked_motion: Vec<f64>,
     points: ContactPoints,
     contact: ContactStep,
     solver: StaticSolver,
@@ -200,8 +200,6 @@ pub struct ModalString<T: Real> {
     rest_modal: Vec<f64>,
     row: Vec<f64>,
     stats: NewtonStats,
-    /// ‖s_free‖₂ of this step, with the rounding margin.
-    step_norm: f64,
     nut_force_change_n: f64,
     bridge_force_change_n: f64,
     rest_nut_force_n: f64,
@@ -232,7 +230,6 @@ impl<T: Real> ModalString<T> {
             modal_force: vec![T::default(); MODE_CAPACITY],
             shapes: vec![T::default(); points * MODE_CAPACITY],
             shape_norms: vec![0.0; points],
-            tracked_motion: vec![0.0; points],
             points: ContactPoints::with_capacity(points),
             contact: ContactStep::new(points),
             solver: StaticSolver::new(points + finger),
@@ -240,7 +237,6 @@ impl<T: Real> ModalString<T> {
             rest_modal: vec![0.0; MODE_CAPACITY],
             row: vec![0.0; MODE_CAPACITY],
             stats: NewtonStats::default(),
-            step_norm: 0.0,
             nut_force_change_n: 0.0,
             bridge_force_change_n: 0.0,
             rest_nut_force_n: 0.0,
@@ -294,7 +290,6 @@ impl<T: Real> ModalString<T> {
             self.modal[k] = T::from_f64(self.row[k] * root - self.rest_modal[k]);
             self.velocity[k] = T::from_f64(self.modal_force[k].to_f64() * root);
         }
-        self.contact.corrections_m.fill(0.0);
         self.refresh_gaps();
         true
     }
@@ -315,7 +310,6 @@ impl<T: Real> ModalString<T> {
             config.string.length_m,
         );
         self.points.couple(&self.modes);
-        self.contact.coupling_changed();
         self.lanes = self.modes.count().div_ceil(LANE_PADDING) * LANE_PADDING;
         for k in 0..MODE_CAPACITY {
             self.a[k] = T::from_f64(self.modes.a[k]);
@@ -393,7 +387,6 @@ impl<T: Real> ModalString<T> {
         self.step.fill(T::default());
         let count = self.points.len();
         self.contact.gaps_m[..count].copy_from_slice(&self.points.rest_gaps_m[..count]);
-        self.contact.corrections_m.fill(0.0);
         self.contact.classify(&self.points, TRACKING_BAND_M);
         self.external_work_j -= energy_before;
         self.nut_force_change_n = 0.0;
@@ -413,22 +406,15 @@ impl<T: Real> ModalString<T> {
             &self.velocity[..lanes],
             &mut self.step[..lanes],
         );
-        let count = self.points.len();
         // The free step of the tracked points exactly; of the others only a bound, ‖Ψ_i‖ ‖s‖.
-        let contact = &mut self.contact;
-        let tracked = contact.tracked_count;
+        let (rows, free_steps) = self.contact.tracked_rows();
         self.kernels.dots(
             &self.shapes,
             MODE_CAPACITY,
-            &contact.tracked[..tracked],
+            rows,
             &self.step[..lanes],
-            &mut self.tracked_motion[..tracked],
+            free_steps,
         );
-        contact.fresh[..count].fill(false);
-        for (&i, &motion) in contact.tracked[..tracked].iter().zip(&self.tracked_motion) {
-            contact.free_steps_m[i] = motion;
-            contact.fresh[i] = true;
-        }
         let mut norm = [0.0];
         self.kernels.dots(
             &self.step[..lanes],
@@ -437,61 +423,39 @@ impl<T: Real> ModalString<T> {
             &self.step[..lanes],
             &mut norm,
         );
-        self.step_norm = norm[0].sqrt() * (1.0 + SHAPE_NORM_MARGIN);
-        let contact = &mut self.contact;
-        contact.gather(&self.points);
-        let mut iterations = 0;
-        let mut converged = true;
-        loop {
-            let contact = &mut self.contact;
-            if !contact.local.settle_if_free() {
-                let (updates, done) = contact.local.solve(&self.config.newton);
-                iterations += updates;
-                converged = done;
-                // The forces at the accepted step, for the update, the outputs and the ledger.
-                contact.local.evaluate();
-            }
-            contact.publish();
-            // Every other point: does it touch during this step? If so, it joins and the
-            // contact solve is redone before anything moves.
-            if !self.check_untracked_points() {
-                break;
-            }
-            self.contact.gather(&self.points);
-        }
+        let step_norm = norm[0].sqrt() * (1.0 + SHAPE_NORM_MARGIN);
+        let (kernels, shapes, modal, step) = (&self.kernels, &self.shapes, &self.modal, &self.step);
+        let rest_gaps = &self.points.rest_gaps_m;
+        let (iterations, converged) = self.contact.solve(
+            &self.points,
+            &self.shape_norms,
+            step_norm,
+            &self.config.newton,
+            |indices, gaps, free_steps| {
+                exact_gaps(kernels, shapes, lanes, rest_gaps, indices, modal, gaps);
+                kernels.dots(shapes, MODE_CAPACITY, indices, &step[..lanes], free_steps);
+            },
+        );
         self.stats.record(iterations, converged);
-
-        let contact = &mut self.contact;
-        let loaded = contact.loaded_count;
-        let mut bridge_change = 0.0;
-        for (value, change) in self.loaded_forces[..loaded]
-            .iter_mut()
-            .zip(&contact.force_changes_n[..loaded])
-        {
-            *value = T::from_f64(*change);
-            bridge_change += change;
-        }
-        let mut penetration = 0.0f64;
-        for i in 0..count {
-            if contact.fresh[i] {
-                contact.gaps_m[i] -= contact.steps_m[i];
-                contact.gap_bounds_m[i] = contact.gaps_m[i];
-                penetration = penetration.max(contact.gaps_m[i]);
-            } else {
-                contact.gap_bounds_m[i] += contact.motion_bounds_m[i];
-            }
-        }
         if self.config.track_energy {
             // Contact damping at this step's forces; the modes' loss needs the whole step below.
-            self.cumulative_losses_j += contact.local.damping_loss_j();
+            self.cumulative_losses_j += self.contact.damping_loss_j();
+        }
+        let penetration = self.contact.finish_step(&self.points);
+
+        let (loaded, changes) = self.contact.loaded();
+        let mut bridge_change = 0.0;
+        for (value, change) in self.loaded_forces.iter_mut().zip(changes) {
+            *value = T::from_f64(*change);
+            bridge_change += change;
         }
         let nut_change = self.kernels.advance(
             &self.b[..lanes],
             &self.nut_weights[..lanes],
             &self.shapes,
             MODE_CAPACITY,
-            &contact.loaded[..loaded],
-            &self.loaded_forces[..loaded],
+            loaded,
+            &self.loaded_forces[..loaded.len()],
             &mut self.modal_force[..lanes],
             &mut self.step[..lanes],
             &mut self.modal[..lanes],
@@ -505,7 +469,13 @@ impl<T: Real> ModalString<T> {
                 })
                 .sum::<f64>();
         }
-        self.update_tracking();
+        let (kernels, shapes, modal) = (&self.kernels, &self.shapes, &self.modal);
+        self.contact.update_tracking(
+            &self.points,
+            TRACKING_BAND_M,
+            2.0 * TRACKING_BAND_M,
+            |indices, gaps| exact_gaps(kernels, shapes, lanes, rest_gaps, indices, modal, gaps),
+        );
         self.nut_force_change_n = nut_change;
         self.bridge_force_change_n = bridge_change;
         self.max_penetration_m = penetration;
@@ -518,94 +488,10 @@ impl<T: Real> ModalString<T> {
         }
     }
 
-    /// The step of every untracked point from the converged forces,
-    /// `Δu_i = Δu_free,i + Σ_j G_ij ΔF_j`: a point that would touch during this step joins the
-    /// tracked set now (returns true: the solve must be redone). A point whose gap bound stays
-    /// below zero after the largest step it can take, `‖Ψ_i‖ ‖s_free‖ + |Σ_j G_ij ΔF_j|`, cannot
-    /// touch and is skipped: its gap bound grows by that much instead. Otherwise its gap and free
-    /// step are computed exactly.
-    fn check_untracked_points(&mut self) -> bool {
-        let mut redo = false;
-        for i in 0..self.points.len() {
-            if self.contact.is_tracked[i] {
-                continue;
-            }
-            let contact = &self.contact;
-            let coupled: f64 = contact.loaded[..contact.loaded_count]
-                .iter()
-                .zip(&contact.force_changes_n)
-                .map(|(&j, change)| self.points.coupling(i, j) * change)
-                .sum();
-            if !contact.fresh[i] {
-                let reach = self.shape_norms[i] * self.step_norm + coupled.abs();
-                if contact.gap_bounds_m[i] + reach <= 0.0 {
-                    self.contact.motion_bounds_m[i] = reach;
-                    continue;
-                }
-                self.refresh_point(i);
-            }
-            let contact = &mut self.contact;
-            let step = contact.free_steps_m[i] + coupled;
-            contact.steps_m[i] = step;
-            if contact.gaps_m[i] - step > 0.0 {
-                contact.corrections_m[i] = step - contact.free_steps_m[i];
-                contact.track(i);
-                redo = true;
-            }
-        }
-        redo
-    }
-
-    /// `Ψ_i · x` in the kernels' precision, accumulated in f64.
-    fn point_dot(&self, i: usize, x: &[T]) -> f64 {
-        let mut out = [0.0];
-        self.kernels.dots(
-            &self.shapes,
-            MODE_CAPACITY,
-            &[i],
-            &x[..self.lanes],
-            &mut out,
-        );
-        out[0]
-    }
-
-    /// Computes point i's gap `a_rest,i − Ψ_i r̃` and free step `Ψ_i s_free` exactly, before the
-    /// step is taken.
-    fn refresh_point(&mut self, i: usize) {
-        let gap = self.points.rest_gaps_m[i] - self.point_dot(i, &self.modal);
-        let free = self.point_dot(i, &self.step);
-        let contact = &mut self.contact;
-        contact.gaps_m[i] = gap;
-        contact.gap_bounds_m[i] = gap;
-        contact.free_steps_m[i] = free;
-        contact.fresh[i] = true;
-    }
-
-    /// After a step: untracked points whose gap bound comes within [`TRACKING_BAND_M`] of
-    /// contact get their exact gap, and join the tracked set if it is within the band; tracked
-    /// points farther than twice that, with no force now or at rest, leave it.
-    fn update_tracking(&mut self) {
-        self.contact
-            .release_far(&self.points, 2.0 * TRACKING_BAND_M);
-        for i in 0..self.points.len() {
-            if self.contact.is_tracked[i] || self.contact.gap_bounds_m[i] <= -TRACKING_BAND_M {
-                continue;
-            }
-            let gap = self.points.rest_gaps_m[i] - self.point_dot(i, &self.modal);
-            let contact = &mut self.contact;
-            contact.gaps_m[i] = gap;
-            contact.gap_bounds_m[i] = gap;
-            if gap > -TRACKING_BAND_M {
-                contact.corrections_m[i] = 0.0;
-                contact.track(i);
-            }
-        }
-    }
-
     /// Forgets Newton's initial guess, so that a new excitation evolves exactly as it would on
     /// a freshly built string.
     fn forget_motion_history(&mut self) {
-        self.contact.corrections_m.fill(0.0);
+        self.contact.forget_corrections();
     }
 
     /// `y_s(x) + Σ_k Ψ_k(x) c_k` for modal coefficients `c_k`, with the sines by recurrence
@@ -848,6 +734,23 @@ impl<T: Real> ModalString<T> {
             .filter(|&i| self.points.rest_forces_n[i] > 0.0)
             .map(|i| self.points.positions_m[i])
             .reduce(f64::max)
+    }
+}
+
+/// The exact gaps `a_rest,i − Ψ_i r̃` of the listed points, in the kernels' precision over the
+/// first `lanes` modes.
+fn exact_gaps<T: Real>(
+    kernels: &Kernels,
+    shapes: &[T],
+    lanes: usize,
+    rest_gaps_m: &[f64],
+    indices: &[usize],
+    modal: &[T],
+    gaps_m: &mut [f64],
+) {
+    kernels.dots(shapes, MODE_CAPACITY, indices, &modal[..lanes], gaps_m);
+    for (gap, &i) in gaps_m.iter_mut().zip(indices) {
+        *gap = rest_gaps_m[i] - *gap;
     }
 }
 
