@@ -184,8 +184,13 @@ pub struct ModalString<T: Real> {
     modal: Vec<T>,
     /// p, the scaled velocity of eq. M1.
     velocity: Vec<T>,
-    /// s, the step (free step, then the whole step).
+    /// s_free, the free step from the current state (kept by every step and every change of
+    /// the state from outside, [`ModalString::prepare_free_step`]).
     step: Vec<T>,
+    /// ‖s_free‖₂², for the far points' bounds.
+    free_step_norm_squared: f64,
+    /// The whole step of the last step, kept only when the losses are booked.
+    whole_step: Vec<T>,
     modal_force: Vec<T>,
     /// Ψ rows in T, `points.capacity() × MODE_CAPACITY` (the force projection).
     shapes: Vec<T>,
@@ -227,6 +232,8 @@ impl<T: Real> ModalString<T> {
             modal: vec![T::default(); MODE_CAPACITY],
             velocity: vec![T::default(); MODE_CAPACITY],
             step: vec![T::default(); MODE_CAPACITY],
+            free_step_norm_squared: 0.0,
+            whole_step: vec![T::default(); MODE_CAPACITY],
             modal_force: vec![T::default(); MODE_CAPACITY],
             shapes: vec![T::default(); points * MODE_CAPACITY],
             shape_norms: vec![0.0; points],
@@ -365,8 +372,32 @@ impl<T: Real> ModalString<T> {
         self.rest_bridge_force_n = self.points.rest_forces_n[..count].iter().sum();
     }
 
-    /// The gaps of every point for the current state: `a_i = a_rest,i − Ψ_i r̃`.
+    /// The free step `s_free = a p − b r` and its norm for the current state: what a step starts
+    /// from. Every change of the state from outside a step ends here.
+    fn prepare_free_step(&mut self) {
+        let lanes = self.lanes;
+        self.kernels.free_step(
+            &self.a[..lanes],
+            &self.b[..lanes],
+            &self.modal[..lanes],
+            &self.velocity[..lanes],
+            &mut self.step[..lanes],
+        );
+        let mut norm = [0.0];
+        self.kernels.dots(
+            &self.step[..lanes],
+            lanes,
+            &[0],
+            &self.step[..lanes],
+            &mut norm,
+        );
+        self.free_step_norm_squared = norm[0];
+    }
+
+    /// The gaps of every point for the current state, `a_i = a_rest,i − Ψ_i r̃`, and the free
+    /// step.
     fn refresh_gaps(&mut self) {
+        self.prepare_free_step();
         let modes = self.modes.count();
         for i in 0..self.points.len() {
             let displacement: f64 = self.points.shape(i)[..modes]
@@ -388,6 +419,7 @@ impl<T: Real> ModalString<T> {
         let count = self.points.len();
         self.contact.gaps_m[..count].copy_from_slice(&self.points.rest_gaps_m[..count]);
         self.contact.classify(&self.points, TRACKING_BAND_M);
+        self.prepare_free_step();
         self.external_work_j -= energy_before;
         self.nut_force_change_n = 0.0;
         self.bridge_force_change_n = 0.0;
@@ -397,15 +429,8 @@ impl<T: Real> ModalString<T> {
     /// Advances one sample (eq. M1 with Newton on the tracked points, section 4). Allocation-free;
     /// never panics.
     pub fn step(&mut self) {
-        // The kernels run over the kept modes, padded to whole registers.
+        // The kernels run over the kept modes, padded to whole registers; `step` holds s_free.
         let lanes = self.lanes;
-        self.kernels.free_step(
-            &self.a[..lanes],
-            &self.b[..lanes],
-            &self.modal[..lanes],
-            &self.velocity[..lanes],
-            &mut self.step[..lanes],
-        );
         // The free step of the tracked points exactly; of the others only a bound, ‖Ψ_i‖ ‖s‖.
         let (rows, free_steps) = self.contact.tracked_rows();
         self.kernels.dots(
@@ -415,15 +440,7 @@ impl<T: Real> ModalString<T> {
             &self.step[..lanes],
             free_steps,
         );
-        let mut norm = [0.0];
-        self.kernels.dots(
-            &self.step[..lanes],
-            lanes,
-            &[0],
-            &self.step[..lanes],
-            &mut norm,
-        );
-        let step_norm = norm[0].sqrt() * (1.0 + SHAPE_NORM_MARGIN);
+        let step_norm = self.free_step_norm_squared.sqrt() * (1.0 + SHAPE_NORM_MARGIN);
         let (kernels, shapes, modal, step) = (&self.kernels, &self.shapes, &self.modal, &self.step);
         let rest_gaps = &self.points.rest_gaps_m;
         let (iterations, converged) = self.contact.solve(
@@ -449,7 +466,13 @@ impl<T: Real> ModalString<T> {
             *value = T::from_f64(*change);
             bridge_change += change;
         }
-        let nut_change = self.kernels.advance(
+        let whole_step = if self.config.track_energy {
+            Some(&mut self.whole_step[..lanes])
+        } else {
+            None
+        };
+        let (nut_change, next_norm_squared) = self.kernels.advance_and_prepare(
+            &self.a[..lanes],
             &self.b[..lanes],
             &self.nut_weights[..lanes],
             &self.shapes,
@@ -460,11 +483,13 @@ impl<T: Real> ModalString<T> {
             &mut self.step[..lanes],
             &mut self.modal[..lanes],
             &mut self.velocity[..lanes],
+            whole_step,
         );
+        self.free_step_norm_squared = next_norm_squared;
         if self.config.track_energy {
             self.cumulative_losses_j += (0..self.modes.count())
                 .map(|k| {
-                    let s = self.step[k].to_f64();
+                    let s = self.whole_step[k].to_f64();
                     self.modes.loss_factor[k] * s * s
                 })
                 .sum::<f64>();

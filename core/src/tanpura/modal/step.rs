@@ -302,12 +302,11 @@ impl ContactStep {
         if !reaches_contact {
             return false;
         }
+        // Branch-free selection: every point is written, the count advances on the selected.
         let mut listed = 0;
-        for i in 0..count {
-            if self.next_bounds_m[i] > 0.0 && self.slots[i] == UNTRACKED {
-                self.candidates[listed] = i;
-                listed += 1;
-            }
+        for (i, &bound) in self.next_bounds_m[..count].iter().enumerate() {
+            self.candidates[listed] = i;
+            listed += usize::from(bound > 0.0);
         }
         refresh(
             &self.candidates[..listed],
@@ -371,12 +370,11 @@ impl ContactStep {
                 slot += 1;
             }
         }
+        // Branch-free selection, as in `check_far_points`; tracked points have a bound of −∞.
         let mut listed = 0;
-        for i in 0..points.len() {
-            if self.far_bounds_m[i] > -band_m {
-                self.candidates[listed] = i;
-                listed += 1;
-            }
+        for (i, &bound) in self.far_bounds_m[..points.len()].iter().enumerate() {
+            self.candidates[listed] = i;
+            listed += usize::from(bound > -band_m);
         }
         if listed == 0 {
             return;
