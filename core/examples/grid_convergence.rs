@@ -5,7 +5,9 @@
 //! in the bench, 2 s, on the FD scheme at the seed's grid (N = 200, 4× oversampling) and refined
 //! (N = 400 at 8× and 16×), and on the modal scheme at the live tier's point spacing and four times
 //! finer; prints the first ten partials (0.5–2 s, the bench's measure) in cents against the seed
-//! grid. About a minute on one core.
+//! grid. Then the rest states behind the difference between the schemes: each one's linearised
+//! fundamental and the end of its rest contact (thread only, or thread and bridge crest). About a
+//! minute on one core.
 
 use javari_core::analysis::{cents, peak_frequency_hz};
 use javari_core::tanpura::excitation::Pluck;
@@ -98,6 +100,33 @@ fn main() {
         println!(
             "{name:32} worst {worst:6.2}  spread {spread:5.2}  {}",
             listed.join(" ")
+        );
+    }
+    println!("rest states: linearised fundamental, end of the rest contact");
+    for intervals in [200, 400] {
+        let mut string = FdString::new(FdStringConfig {
+            intervals,
+            ..FdStringConfig::REFERENCE
+        });
+        let fundamental = string.linearised_fundamental_hz();
+        let end = string.rest_contact_end_m().unwrap_or(f64::NAN);
+        println!(
+            "FD N = {intervals:3}: {fundamental:.3} Hz, {:.2} mm",
+            end * 1e3
+        );
+    }
+    for spacing in [1e-3, 0.25e-3] {
+        let mut string: ModalString<f64> = ModalString::new(ModalStringConfig {
+            bridge_point_spacing_m: spacing,
+            thread_point_spacing_m: 0.5 * spacing,
+            ..ModalStringConfig::REFERENCE
+        });
+        let fundamental = string.linearised_fundamental_hz();
+        let end = string.rest_contact_end_m().unwrap_or(f64::NAN);
+        println!(
+            "modal, {:.2} mm points: {fundamental:.3} Hz, {:.2} mm",
+            spacing * 1e3,
+            end * 1e3
         );
     }
 }
