@@ -16,7 +16,8 @@
 //! | `plpos` | Pluck position | mm | 50–600 | 350 | pluck point from the tuning bead |
 //! | `plwid` | Pluck width | mm | 2–40 | 10 | fingertip width |
 //! | `plamp` | Pluck amplitude | mm | 0–5 | 2 | finger lift at full velocity |
-//! | `pick` | Pickup | % nut | 0–100 | 100 | 100: nut force, 0: bridge force |
+//! | `tout` | Tanpura output | | Radiated, Pickup | Radiated | the body's radiated sound (the total bridge force through the tanpura body of `core/src/tanpura/body.rs`), or the pickup forces below |
+//! | `pick` | Pickup | % nut | 0–100 | 100 | with output Pickup: 100: nut force, 0: bridge force |
 //! | `qual` | Quality | | Draft, Live, Studio, Reference | Live | the core's tiers (`core/src/quality.rs`); not part of the factory presets |
 //! | `gain` | Output gain | dB | −60–24 | 0 | after 2 N = full scale |
 //! | `drone` | Drone | on/off | | off | a held note sets Sa and the strings play the cycle |
@@ -39,7 +40,8 @@ use javari_core::engine::preset::{
     Preset, BOW_POSITION_RANGE, BOW_VELOCITY_RANGE_M_S, PLUCK_POSITION_RANGE_M,
 };
 use javari_core::engine::{
-    BowedEngineSettings, BowedStringKind, EngineSettings, Instrument, OUTPUT_GAIN_RANGE_DB,
+    BowedEngineSettings, BowedStringKind, EngineSettings, Instrument, TanpuraOutput,
+    OUTPUT_GAIN_RANGE_DB,
 };
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::geometry::ThreadSettings;
@@ -118,6 +120,15 @@ pub enum QualityChoice {
     Reference,
 }
 
+/// What the tanpura's output is (`javari_core::engine::TanpuraOutput`).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TanpuraOutputChoice {
+    #[id = "radiated"]
+    Radiated,
+    #[id = "pickup"]
+    Pickup,
+}
+
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FirstStringChoice {
     #[id = "pa"]
@@ -160,6 +171,8 @@ pub struct JavariParams {
     pub pluck_width_mm: FloatParam,
     #[id = "plamp"]
     pub pluck_amplitude_mm: FloatParam,
+    #[id = "tout"]
+    pub tanpura_output: EnumParam<TanpuraOutputChoice>,
     #[id = "pick"]
     pub nut_pickup_percent: FloatParam,
     #[id = "qual"]
@@ -283,6 +296,7 @@ impl Default for JavariParams {
             .with_step_size(0.1),
             // Live by default: a DAW needs real time; the renderer defaults to Reference.
             quality: EnumParam::new("Quality", QualityChoice::Live),
+            tanpura_output: EnumParam::new("Tanpura output", TanpuraOutputChoice::Radiated),
             output_gain_db: FloatParam::new(
                 "Output gain",
                 0.0,
@@ -401,9 +415,14 @@ impl JavariParams {
             QualityChoice::Studio => Quality::Studio,
             QualityChoice::Reference => Quality::Reference,
         };
+        let tanpura_output = match self.tanpura_output.value() {
+            TanpuraOutputChoice::Radiated => TanpuraOutput::Radiated,
+            TanpuraOutputChoice::Pickup => TanpuraOutput::Pickup,
+        };
         if let Some(preset) = preset {
             let mut settings = preset.settings;
             settings.voice.quality = quality;
+            settings.tanpura_output = tanpura_output;
             settings.output_gain_db += gain_db;
             settings.drone = drone_from_knobs;
             return settings;
@@ -428,6 +447,7 @@ impl JavariParams {
             },
             output_gain_db: gain_db,
             drone: drone_from_knobs,
+            tanpura_output,
             instrument: match self.instrument.value() {
                 InstrumentChoice::Tanpura => Instrument::Tanpura,
                 InstrumentChoice::Bowed => Instrument::Bowed,

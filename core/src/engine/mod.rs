@@ -34,6 +34,7 @@ pub mod smoothing;
 pub mod wav;
 
 use crate::bowed::{BowedEvent, BowedInstrument, BowedPlayerSettings, StringConstants};
+use crate::tanpura::body::{Body, TANPURA_BODY};
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
 use drone::{string_ratios, DroneSequencer, DroneSettings};
@@ -118,6 +119,19 @@ impl Default for BowedEngineSettings {
     }
 }
 
+/// What the tanpura's output is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TanpuraOutput {
+    /// The strings' forces at the nut and the bridge, mixed by
+    /// [`VoiceSettings::nut_pickup_weight`] (1: the nut force, the seed's signal; 0: the bridge
+    /// force).
+    #[default]
+    Pickup,
+    /// The sound the body radiates: the total bridge force of all strings through the body's
+    /// resonances (`tanpura/body.rs`, fitted to the response measured in DAFx-16).
+    Radiated,
+}
+
 /// Everything the engine plays with, in SI units (normalised mappings live in the plugin).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EngineSettings {
@@ -131,6 +145,8 @@ pub struct EngineSettings {
     pub drone: DroneSettings,
     pub instrument: Instrument,
     pub bowed: BowedEngineSettings,
+    /// The tanpura's output: pickup forces or the body's radiated sound.
+    pub tanpura_output: TanpuraOutput,
 }
 
 impl Default for EngineSettings {
@@ -142,6 +158,7 @@ impl Default for EngineSettings {
             drone: DroneSettings::default(),
             instrument: Instrument::Tanpura,
             bowed: BowedEngineSettings::default(),
+            tanpura_output: TanpuraOutput::Pickup,
         }
     }
 }
@@ -278,6 +295,8 @@ pub struct Engine {
     applied_bow_controls: Option<(f64, f64, f64)>,
     /// One buffer per voice for [`Engine::process_with`] (empty until it is used).
     scratch: Vec<Vec<f32>>,
+    /// The tanpura's body, between the strings' total bridge force and the output.
+    body: Body,
 }
 
 /// `ln(1 + k_b)`: stiffness ramps in a logarithmic domain (its range spans twelve decades) that
@@ -343,6 +362,7 @@ impl Engine {
                 .collect(),
             applied_bow_controls: None,
             scratch: Vec::new(),
+            body: Body::new(&TANPURA_BODY, sample_rate_hz),
         };
         engine.target.voice = voice;
         engine.apply_bowed_settings();
@@ -493,6 +513,7 @@ impl Engine {
             slot.plucked_at = 0;
         }
         self.drone.reset();
+        self.body.reset();
         self.clock = 0;
         self.next_control_tick = 0;
         for instrument in &mut self.bowed {
@@ -611,6 +632,15 @@ impl Engine {
                 }
             }
         }
+        if self.target.instrument == Instrument::Tanpura
+            && self.target.tanpura_output == TanpuraOutput::Radiated
+        {
+            // The strings' outputs are their bridge forces here (`control_tick`), summed: the
+            // body is driven by the total force on the bridge.
+            for sample in output.iter_mut() {
+                *sample = self.body.tick(f64::from(*sample)) as f32;
+            }
+        }
         for sample in output.iter_mut() {
             *sample *= self.output_gain.step() as f32;
         }
@@ -625,6 +655,10 @@ impl Engine {
         settings.gamma_per_s = self.gamma.step();
         settings.eta_s = self.eta.step();
         settings.nut_pickup_weight = self.pickup_weight.step();
+        if self.target.tanpura_output == TanpuraOutput::Radiated {
+            // The body hears the bridge.
+            settings.nut_pickup_weight = 0.0;
+        }
         settings.fundamental_hz = self.current_voice.fundamental_hz;
         if settings == self.current_voice {
             return;

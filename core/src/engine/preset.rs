@@ -17,7 +17,8 @@
 //! | `bridge_beyond_thread` | bool | | false: no bridge contact past the thread |
 //! | `gamma_per_s` | 1/s | 0–20 | frequency-independent loss γ |
 //! | `eta_s` | s | 0–1e-6 | frequency-dependent loss η |
-//! | `nut_pickup_weight` | 1 | 0–1 | 1: nut force, 0: bridge force |
+//! | `nut_pickup_weight` | 1 | 0–1 | with output pickup: 1: nut force, 0: bridge force |
+//! | `tanpura_output` | text | pickup, radiated | the pickup forces, or the body's radiated sound |
 //! | `quality` | text | draft, live, studio, reference | speed against accuracy (`quality.rs`) |
 //! | `pluck_position_m` | m | 0.05–0.6 | pluck point from the tuning bead |
 //! | `pluck_width_m` | m | 0.002–0.040 | fingertip width |
@@ -38,7 +39,7 @@
 //! | `bow_body` | bool | | the body resonance filter |
 
 use super::drone::TEMPO_RANGE_BPM;
-use super::{BowedStringKind, EngineSettings, Instrument, OUTPUT_GAIN_RANGE_DB};
+use super::{BowedStringKind, EngineSettings, Instrument, TanpuraOutput, OUTPUT_GAIN_RANGE_DB};
 use crate::bowed::BowTier;
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::geometry::ThreadSettings;
@@ -63,6 +64,9 @@ pub const BOW_MODEL_NAMES: [&str; 2] = ["rounded-corner", "bow-table"];
 pub const BOW_STRING_NAMES: [&str; 2] = ["violin-a", "cello-d"];
 pub const BOW_VELOCITY_RANGE_M_S: (f64, f64) = (0.02, 1.0);
 pub const BOW_POSITION_RANGE: (f64, f64) = (0.02, 0.5);
+
+/// Names of the tanpura's outputs ([`TanpuraOutput`]), as written in presets.
+pub const TANPURA_OUTPUT_NAMES: [&str; 2] = ["pickup", "radiated"];
 
 /// Names of the first drone string's choices, as written in presets.
 pub const FIRST_STRING_NAMES: [&str; 3] = ["pa", "ma", "ni"];
@@ -130,7 +134,7 @@ impl Kind {
 }
 
 /// Every key and what it takes, in the order of [`PresetFile`] and of the table above.
-const KEYS: [(&str, Kind); 26] = [
+const KEYS: [(&str, Kind); 27] = [
     ("name", Kind::Text),
     (
         "bridge_stiffness_n_m2",
@@ -145,6 +149,7 @@ const KEYS: [(&str, Kind); 26] = [
     ("gamma_per_s", Kind::Number(VoiceSettings::GAMMA_RANGE)),
     ("eta_s", Kind::Number(VoiceSettings::ETA_RANGE)),
     ("nut_pickup_weight", Kind::Number((0.0, 1.0))),
+    ("tanpura_output", Kind::Choice(&TANPURA_OUTPUT_NAMES)),
     ("quality", Kind::Choice(&QUALITY_NAMES)),
     ("pluck_position_m", Kind::Number(PLUCK_POSITION_RANGE_M)),
     ("pluck_width_m", Kind::Number(Pluck::WIDTH_RANGE_M)),
@@ -184,6 +189,7 @@ struct PresetFile {
     gamma_per_s: Option<Spanned<f64>>,
     eta_s: Option<Spanned<f64>>,
     nut_pickup_weight: Option<Spanned<f64>>,
+    tanpura_output: Option<Spanned<String>>,
     quality: Option<Spanned<String>>,
     pluck_position_m: Option<Spanned<f64>>,
     pluck_width_m: Option<Spanned<f64>>,
@@ -388,6 +394,13 @@ impl Preset {
             &mut voice.nut_pickup_weight,
             check.number("nut_pickup_weight", read.nut_pickup_weight)?,
         );
+        if let Some(output) = check.choice("tanpura_output", read.tanpura_output)? {
+            settings.tanpura_output = match output {
+                "radiated" => TanpuraOutput::Radiated,
+                _ => TanpuraOutput::Pickup,
+            };
+        }
+        let voice = &mut settings.voice;
         if let Some(name) = check.choice("quality", read.quality)? {
             voice.quality = Quality::from_name(name).expect("QUALITY_NAMES are the tiers' names");
         }
@@ -482,6 +495,7 @@ impl Preset {
             gamma_per_s: value(v.gamma_per_s),
             eta_s: value(v.eta_s),
             nut_pickup_weight: value(v.nut_pickup_weight),
+            tanpura_output: text(TANPURA_OUTPUT_NAMES[s.tanpura_output as usize]),
             quality: text(v.quality.name()),
             pluck_position_m: value(s.pluck.position_m),
             pluck_width_m: value(s.pluck.width_m),
@@ -521,6 +535,7 @@ mod tests {
         preset.settings.drone.enabled = true;
         preset.settings.drone.first_string = FirstString::Ni;
         preset.settings.voice.quality = Quality::Studio;
+        preset.settings.tanpura_output = TanpuraOutput::Radiated;
         preset.settings.instrument = Instrument::Bowed;
         preset.settings.bowed.string = BowedStringKind::CelloD;
         preset.settings.bowed.player.tier = BowTier::BowTable;

@@ -245,3 +245,41 @@ fn quality_change_keeps_ringing_strings_and_applies_from_the_next_pluck() {
         "the same string, now at the new tier"
     );
 }
+
+fn radiated() -> EngineSettings {
+    EngineSettings {
+        tanpura_output: TanpuraOutput::Radiated,
+        ..EngineSettings::default()
+    }
+}
+
+#[test]
+fn radiated_default_pluck_peaks_near_minus_12_dbfs() {
+    let mut engine = Engine::new(&radiated(), RATE, 1);
+    let output = run(&mut engine, &[note_on(0, 54)], 22_050);
+    let peak_dbfs = 20.0 * f64::from(peak(&output)).log10();
+    println!("radiated default pluck peak: {peak_dbfs:.2} dBFS");
+    assert!((-15.0..=-9.0).contains(&peak_dbfs), "{peak_dbfs} dBFS");
+}
+
+#[test]
+fn radiated_output_is_the_total_bridge_force_through_the_body() {
+    // Two strings ringing together: the body hears their summed bridge force.
+    let events = [note_on(0, 50), note_on(3_000, 57)];
+    let mut radiating = Engine::new(&radiated(), RATE, 2);
+    let heard = run(&mut radiating, &events, 11_025);
+    let mut bridge_settings = EngineSettings::default();
+    bridge_settings.voice.nut_pickup_weight = 0.0;
+    let mut bridge = Engine::new(&bridge_settings, RATE, 2);
+    let forces = run(&mut bridge, &events, 11_025);
+    let mut body = Body::new(&TANPURA_BODY, RATE);
+    let expected: Vec<f32> = forces
+        .iter()
+        .map(|force| body.tick(f64::from(*force)) as f32)
+        .collect();
+    assert_eq!(heard, expected);
+    assert!(peak(&heard) > 1e-3);
+    // And it is not the pickup signal.
+    let mut pickup = Engine::new(&EngineSettings::default(), RATE, 2);
+    assert_ne!(run(&mut pickup, &events, 11_025), heard);
+}

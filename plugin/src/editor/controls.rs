@@ -161,8 +161,10 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
                 "How the string is simulated. Draft and Live: the string's exact modes at the output rate with contact on a few points (fast, no latency). Studio and Reference: the seed's finite-difference grid at 2x and 4x oversampling (more accurate to the paper, far more CPU; watch the load meter above).");
         });
         group(ui, "Output", |ui| {
+            row(ui, setter, &params.tanpura_output,
+                "Radiated: the tanpura as a listener hears it, the strings' total force on the bridge through the body's resonances (fitted to the response van Walstijn, Bridges and Mehes measured on a tanpura, DAFx-16). Pickup: the raw string forces chosen below.");
             row(ui, setter, &params.nut_pickup_percent,
-                "What you hear: 100 % is the force the string exerts on the nut (eq. 13), 0 % the force on bridge and thread (eq. 12), in between a mix.");
+                "With output Pickup: 100 % is the force the string exerts on the nut (eq. 13, the seed's signal), 0 % the force on bridge and thread (eq. 12), in between a mix.");
             row(ui, setter, &params.output_gain_db,
                 "Output level. At 0 dB a pickup force of 2 N is digital full scale.");
         });
