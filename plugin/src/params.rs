@@ -21,7 +21,13 @@
 //! | `qual` | Quality | | Draft, Live, Studio, Reference | Live | the core's tiers (`core/src/quality.rs`); not part of the factory presets |
 //! | `gain` | Output gain | dB | −60–24 | 0 | after 2 N = full scale |
 //! | `drone` | Drone | on/off | | off | a held note sets Sa and the strings play the cycle |
-//! | `first` | First string | | Pa, Ma, Ni | Pa | first drone string: 3/4, 2/3 or 15/16 of Sa |
+//! | `first` | First string | | Pa, Ma, Ni, komal Ni, Dha | Pa | first drone string: 3/4, 2/3, 15/16, 8/9 or 5/6 of Sa (just intonation) |
+//! | `dpat` | Drone strings | | 4, 5, 6 strings | 4 strings | Pa Sa Sa sa; Pa Ni Sa Sa sa; Pa Pa Sa Sa sa sa (with the first string's note for Pa) |
+//! | `dspace` | Pluck spacing | beats | 0.25–4 | 1 | gap after each pluck |
+//! | `dpause` | Cycle pause | beats | 0–8 | 1 | extra gap after the cycle's last pluck |
+//! | `dhtime` | Humanise timing | ms | 0–50 | 0 | largest displacement of a pluck |
+//! | `dhstr` | Humanise strength | % | 0–50 | 0 | largest softening of a pluck |
+//! | `dseed` | Humanise seed | | 0–9999 | 0 | the same seed plays the same way |
 //! | `dsync` | Drone tempo sync | on/off | | on | follow the host's tempo |
 //! | `dbpm` | Drone tempo | bpm | 20–300 | 60 | tempo without sync |
 //! | `inst` | Instrument | | Tanpura, Bowed | Tanpura | plucked tanpura strings or one bowed string |
@@ -35,7 +41,10 @@
 //! | `body` | Body | on/off | | on | the violin-body resonance filter |
 
 use javari_core::bowed::{BowTier, BowedPlayerSettings};
-use javari_core::engine::drone::TEMPO_RANGE_BPM;
+use javari_core::engine::drone::{
+    DronePattern, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE, HUMANIZE_TIMING_RANGE_S,
+    PLUCK_SPACING_RANGE_BEATS, TEMPO_RANGE_BPM,
+};
 use javari_core::engine::preset::{
     Preset, BOW_POSITION_RANGE, BOW_VELOCITY_RANGE_M_S, PLUCK_POSITION_RANGE_M,
 };
@@ -137,6 +146,25 @@ pub enum FirstStringChoice {
     Ma,
     #[id = "ni"]
     Ni,
+    #[id = "komal-ni"]
+    #[name = "komal Ni"]
+    KomalNi,
+    #[id = "dha"]
+    Dha,
+}
+
+/// The drone's strings (`javari_core::engine::drone::DronePattern`).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DronePatternChoice {
+    #[id = "four"]
+    #[name = "4 strings"]
+    Four,
+    #[id = "five"]
+    #[name = "5 strings"]
+    Five,
+    #[id = "six"]
+    #[name = "6 strings"]
+    Six,
 }
 
 const MM_PER_M: f64 = 1000.0;
@@ -187,6 +215,18 @@ pub struct JavariParams {
     pub drone_tempo_sync: BoolParam,
     #[id = "dbpm"]
     pub drone_tempo_bpm: FloatParam,
+    #[id = "dpat"]
+    pub drone_pattern: EnumParam<DronePatternChoice>,
+    #[id = "dspace"]
+    pub drone_spacing_beats: FloatParam,
+    #[id = "dpause"]
+    pub drone_pause_beats: FloatParam,
+    #[id = "dhtime"]
+    pub drone_humanize_ms: FloatParam,
+    #[id = "dhstr"]
+    pub drone_humanize_percent: FloatParam,
+    #[id = "dseed"]
+    pub drone_seed: IntParam,
     #[id = "inst"]
     pub instrument: EnumParam<InstrumentChoice>,
     #[id = "bmodel"]
@@ -320,6 +360,48 @@ impl Default for JavariParams {
             )
             .with_unit(" bpm")
             .with_step_size(0.1),
+            drone_pattern: EnumParam::new("Drone strings", DronePatternChoice::Four),
+            drone_spacing_beats: FloatParam::new(
+                "Pluck spacing",
+                1.0,
+                FloatRange::Linear {
+                    min: PLUCK_SPACING_RANGE_BEATS.0 as f32,
+                    max: PLUCK_SPACING_RANGE_BEATS.1 as f32,
+                },
+            )
+            .with_unit(" beats")
+            .with_step_size(0.05),
+            drone_pause_beats: FloatParam::new(
+                "Cycle pause",
+                1.0,
+                FloatRange::Linear {
+                    min: CYCLE_PAUSE_RANGE_BEATS.0 as f32,
+                    max: CYCLE_PAUSE_RANGE_BEATS.1 as f32,
+                },
+            )
+            .with_unit(" beats")
+            .with_step_size(0.05),
+            drone_humanize_ms: FloatParam::new(
+                "Humanise timing",
+                0.0,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: (HUMANIZE_TIMING_RANGE_S.1 * 1000.0) as f32,
+                },
+            )
+            .with_unit(" ms")
+            .with_step_size(0.5),
+            drone_humanize_percent: FloatParam::new(
+                "Humanise strength",
+                0.0,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: (HUMANIZE_STRENGTH_RANGE.1 * 100.0) as f32,
+                },
+            )
+            .with_unit(" %")
+            .with_step_size(1.0),
+            drone_seed: IntParam::new("Humanise seed", 0, IntRange::Linear { min: 0, max: 9999 }),
             instrument: EnumParam::new("Instrument", InstrumentChoice::Tanpura),
             bow_model: EnumParam::new("Bow model", BowModelChoice::RoundedCorner),
             bowed_string: EnumParam::new("Bowed string", BowedStringChoice::ViolinA),
@@ -394,9 +476,21 @@ impl JavariParams {
                 FirstStringChoice::Pa => FirstString::Pa,
                 FirstStringChoice::Ma => FirstString::Ma,
                 FirstStringChoice::Ni => FirstString::Ni,
+                FirstStringChoice::KomalNi => FirstString::KomalNi,
+                FirstStringChoice::Dha => FirstString::Dha,
+            },
+            pattern: match self.drone_pattern.value() {
+                DronePatternChoice::Four => DronePattern::Four,
+                DronePatternChoice::Five => DronePattern::Five,
+                DronePatternChoice::Six => DronePattern::Six,
             },
             tempo_sync: self.drone_tempo_sync.value(),
             free_tempo_bpm: f64::from(self.drone_tempo_bpm.value()),
+            pluck_spacing_beats: f64::from(self.drone_spacing_beats.value()),
+            cycle_pause_beats: f64::from(self.drone_pause_beats.value()),
+            humanize_timing_s: f64::from(self.drone_humanize_ms.value()) / 1000.0,
+            humanize_strength: f64::from(self.drone_humanize_percent.value()) / 100.0,
+            humanize_seed: self.drone_seed.value().max(0) as u32,
         };
         let preset = match self.preset.value() {
             PresetChoice::Custom => None,

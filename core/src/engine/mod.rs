@@ -572,7 +572,10 @@ impl Engine {
                 end = end.min(timed.offset.min(length - 1));
             }
             end = end.min(position + (self.next_control_tick - self.clock) as usize);
-            if let Some(pluck_sample) = self.drone.next_pluck_sample() {
+            if let Some(pluck_sample) = self
+                .drone
+                .next_pluck_sample(&self.target.drone, self.sample_rate_hz)
+            {
                 let until = pluck_sample.saturating_sub(self.clock).max(1);
                 end = end.min(position + until.min(length as u64) as usize);
             }
@@ -744,19 +747,20 @@ impl Engine {
             (true, Some(host)) => host,
             _ => drone.free_tempo_bpm,
         };
-        let Some(string) = self
+        let Some(pluck) = self
             .drone
-            .take_due_pluck(self.clock, tempo, self.sample_rate_hz)
+            .take_due_pluck(self.clock, &drone, tempo, self.sample_rate_hz)
         else {
             return;
         };
         let Some(sa_note) = self.drone.sa_note() else {
             return;
         };
-        let hz = pitch::note_to_hz(sa_note) * string_ratios(drone.first_string)[string];
+        let (ratios, _) = string_ratios(drone.first_string, drone.pattern);
+        let hz = pitch::note_to_hz(sa_note) * ratios[pluck.string];
         let (low, high) = VoiceSettings::FUNDAMENTAL_RANGE_HZ;
         if (low..=high).contains(&hz) {
-            self.pluck_string(StringKey::Drone(string), hz, 1.0);
+            self.pluck_string(StringKey::Drone(pluck.string), hz, pluck.strength as f32);
         }
     }
 

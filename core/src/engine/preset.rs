@@ -25,9 +25,15 @@
 //! | `pluck_amplitude_m` | m | 0–0.005 | finger lift at full velocity |
 //! | `output_gain_db` | dB | −60–24 | output gain |
 //! | `drone_enabled` | bool | | drone mode |
-//! | `drone_first_string` | text | pa, ma, ni | first drone string |
+//! | `drone_first_string` | text | pa, ma, ni, komal-ni, dha | first drone string (`FirstString`) |
+//! | `drone_pattern` | text | four, five, six | the drone's strings (`drone.rs`) |
 //! | `drone_tempo_sync` | bool | | follow the host tempo |
 //! | `drone_tempo_bpm` | 1/min | 20–300 | tempo without sync |
+//! | `drone_pluck_spacing_beats` | beats | 0.25–4 | gap after each pluck |
+//! | `drone_cycle_pause_beats` | beats | 0–8 | extra gap after the cycle's last pluck |
+//! | `drone_humanize_timing_s` | s | 0–0.05 | largest timing displacement of a pluck |
+//! | `drone_humanize_strength` | 1 | 0–0.5 | largest softening of a pluck |
+//! | `drone_humanize_seed` | 1 | 0–4294967295 | the humanisation's seed (whole number) |
 //! | `instrument` | text | tanpura, bowed | which instrument plays |
 //! | `bow_model` | text | rounded-corner, bow-table | the bowed tier |
 //! | `bow_string` | text | violin-a, cello-d | the bowed string's constants |
@@ -38,7 +44,10 @@
 //! | `bow_vibrato_cents` | cents | 0–100 | vibrato depth at full modulation wheel |
 //! | `bow_body` | bool | | the body resonance filter |
 
-use super::drone::TEMPO_RANGE_BPM;
+use super::drone::{
+    DronePattern, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE, HUMANIZE_TIMING_RANGE_S,
+    PLUCK_SPACING_RANGE_BEATS, TEMPO_RANGE_BPM,
+};
 use super::{BowedStringKind, EngineSettings, Instrument, TanpuraOutput, OUTPUT_GAIN_RANGE_DB};
 use crate::bowed::BowTier;
 use crate::tanpura::excitation::Pluck;
@@ -69,14 +78,16 @@ pub const BOW_POSITION_RANGE: (f64, f64) = (0.02, 0.5);
 pub const TANPURA_OUTPUT_NAMES: [&str; 2] = ["pickup", "radiated"];
 
 /// Names of the first drone string's choices, as written in presets.
-pub const FIRST_STRING_NAMES: [&str; 3] = ["pa", "ma", "ni"];
+pub const FIRST_STRING_NAMES: [&str; 5] = ["pa", "ma", "ni", "komal-ni", "dha"];
+/// Names of the drone patterns, as written in presets.
+pub const DRONE_PATTERN_NAMES: [&str; 3] = ["four", "five", "six"];
 
 fn first_string_name(first: FirstString) -> &'static str {
-    match first {
-        FirstString::Pa => "pa",
-        FirstString::Ma => "ma",
-        FirstString::Ni => "ni",
-    }
+    let index = FirstString::ALL
+        .iter()
+        .position(|candidate| *candidate == first)
+        .unwrap_or(0);
+    FIRST_STRING_NAMES[index]
 }
 
 /// A named set of engine settings.
@@ -134,7 +145,7 @@ impl Kind {
 }
 
 /// Every key and what it takes, in the order of [`PresetFile`] and of the table above.
-const KEYS: [(&str, Kind); 27] = [
+const KEYS: [(&str, Kind); 33] = [
     ("name", Kind::Text),
     (
         "bridge_stiffness_n_m2",
@@ -157,8 +168,26 @@ const KEYS: [(&str, Kind); 27] = [
     ("output_gain_db", Kind::Number(OUTPUT_GAIN_RANGE_DB)),
     ("drone_enabled", Kind::Switch),
     ("drone_first_string", Kind::Choice(&FIRST_STRING_NAMES)),
+    ("drone_pattern", Kind::Choice(&DRONE_PATTERN_NAMES)),
     ("drone_tempo_sync", Kind::Switch),
     ("drone_tempo_bpm", Kind::Number(TEMPO_RANGE_BPM)),
+    (
+        "drone_pluck_spacing_beats",
+        Kind::Number(PLUCK_SPACING_RANGE_BEATS),
+    ),
+    (
+        "drone_cycle_pause_beats",
+        Kind::Number(CYCLE_PAUSE_RANGE_BEATS),
+    ),
+    (
+        "drone_humanize_timing_s",
+        Kind::Number(HUMANIZE_TIMING_RANGE_S),
+    ),
+    (
+        "drone_humanize_strength",
+        Kind::Number(HUMANIZE_STRENGTH_RANGE),
+    ),
+    ("drone_humanize_seed", Kind::Number((0.0, 4_294_967_295.0))),
     ("instrument", Kind::Choice(&INSTRUMENT_NAMES)),
     ("bow_model", Kind::Choice(&BOW_MODEL_NAMES)),
     ("bow_string", Kind::Choice(&BOW_STRING_NAMES)),
@@ -197,8 +226,14 @@ struct PresetFile {
     output_gain_db: Option<Spanned<f64>>,
     drone_enabled: Option<Spanned<bool>>,
     drone_first_string: Option<Spanned<String>>,
+    drone_pattern: Option<Spanned<String>>,
     drone_tempo_sync: Option<Spanned<bool>>,
     drone_tempo_bpm: Option<Spanned<f64>>,
+    drone_pluck_spacing_beats: Option<Spanned<f64>>,
+    drone_cycle_pause_beats: Option<Spanned<f64>>,
+    drone_humanize_timing_s: Option<Spanned<f64>>,
+    drone_humanize_strength: Option<Spanned<f64>>,
+    drone_humanize_seed: Option<Spanned<f64>>,
     instrument: Option<Spanned<String>>,
     bow_model: Option<Spanned<String>>,
     bow_string: Option<Spanned<String>>,
@@ -422,11 +457,18 @@ impl Preset {
         );
         set_switch(&mut settings.drone.enabled, switch(read.drone_enabled));
         if let Some(first) = check.choice("drone_first_string", read.drone_first_string)? {
-            settings.drone.first_string = match first {
-                "ma" => FirstString::Ma,
-                "ni" => FirstString::Ni,
-                _ => FirstString::Pa,
-            };
+            let index = FIRST_STRING_NAMES
+                .iter()
+                .position(|name| *name == first)
+                .unwrap_or(0);
+            settings.drone.first_string = FirstString::ALL[index];
+        }
+        if let Some(pattern) = check.choice("drone_pattern", read.drone_pattern)? {
+            let index = DRONE_PATTERN_NAMES
+                .iter()
+                .position(|name| *name == pattern)
+                .unwrap_or(0);
+            settings.drone.pattern = DronePattern::ALL[index];
         }
         set_switch(
             &mut settings.drone.tempo_sync,
@@ -436,6 +478,26 @@ impl Preset {
             &mut settings.drone.free_tempo_bpm,
             check.number("drone_tempo_bpm", read.drone_tempo_bpm)?,
         );
+        set(
+            &mut settings.drone.pluck_spacing_beats,
+            check.number("drone_pluck_spacing_beats", read.drone_pluck_spacing_beats)?,
+        );
+        set(
+            &mut settings.drone.cycle_pause_beats,
+            check.number("drone_cycle_pause_beats", read.drone_cycle_pause_beats)?,
+        );
+        set(
+            &mut settings.drone.humanize_timing_s,
+            check.number("drone_humanize_timing_s", read.drone_humanize_timing_s)?,
+        );
+        set(
+            &mut settings.drone.humanize_strength,
+            check.number("drone_humanize_strength", read.drone_humanize_strength)?,
+        );
+        if let Some(seed) = check.number("drone_humanize_seed", read.drone_humanize_seed)? {
+            // In range, so the conversion only drops a fraction.
+            settings.drone.humanize_seed = seed as u32;
+        }
         if let Some(instrument) = check.choice("instrument", read.instrument)? {
             settings.instrument = match instrument {
                 "bowed" => Instrument::Bowed,
@@ -503,8 +565,14 @@ impl Preset {
             output_gain_db: value(s.output_gain_db),
             drone_enabled: Some(Spanned::new(0..0, s.drone.enabled)),
             drone_first_string: text(first_string_name(s.drone.first_string)),
+            drone_pattern: text(DRONE_PATTERN_NAMES[s.drone.pattern as usize]),
             drone_tempo_sync: Some(Spanned::new(0..0, s.drone.tempo_sync)),
             drone_tempo_bpm: value(s.drone.free_tempo_bpm),
+            drone_pluck_spacing_beats: value(s.drone.pluck_spacing_beats),
+            drone_cycle_pause_beats: value(s.drone.cycle_pause_beats),
+            drone_humanize_timing_s: value(s.drone.humanize_timing_s),
+            drone_humanize_strength: value(s.drone.humanize_strength),
+            drone_humanize_seed: value(f64::from(s.drone.humanize_seed)),
             instrument: text(INSTRUMENT_NAMES[s.instrument as usize]),
             bow_model: text(BOW_MODEL_NAMES[s.bowed.player.tier as usize]),
             bow_string: text(BOW_STRING_NAMES[s.bowed.string as usize]),
@@ -533,7 +601,10 @@ mod tests {
         preset.settings.voice.thread_enabled = false;
         preset.settings.pluck.width_m = 0.02;
         preset.settings.drone.enabled = true;
-        preset.settings.drone.first_string = FirstString::Ni;
+        preset.settings.drone.first_string = FirstString::KomalNi;
+        preset.settings.drone.pattern = DronePattern::Five;
+        preset.settings.drone.humanize_seed = 4_000_000_000;
+        preset.settings.drone.humanize_timing_s = 0.012;
         preset.settings.voice.quality = Quality::Studio;
         preset.settings.tanpura_output = TanpuraOutput::Radiated;
         preset.settings.instrument = Instrument::Bowed;

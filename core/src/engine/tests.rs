@@ -283,3 +283,27 @@ fn radiated_output_is_the_total_bridge_force_through_the_body() {
     let mut pickup = Engine::new(&EngineSettings::default(), RATE, 2);
     assert_ne!(run(&mut pickup, &events, 11_025), heard);
 }
+
+#[test]
+fn six_string_drone_plucks_every_string_on_the_host_beat_to_the_sample() {
+    let mut settings = EngineSettings::default();
+    settings.drone.enabled = true;
+    settings.drone.pattern = drone::DronePattern::Six;
+    settings.drone.first_string = crate::tanpura::FirstString::Dha;
+    let mut engine = Engine::new(&settings, RATE, 8);
+    engine.set_host_tempo(Some(93.0)); // 28 451.6… samples per beat
+    let beat = 60.0 * RATE / 93.0;
+    run(&mut engine, &[note_on(0, 50)], (5.5 * beat) as usize);
+    let sa_hz = pitch::note_to_hz(50);
+    let ratios = [5.0 / 6.0, 5.0 / 6.0, 1.0, 1.0, 0.5, 0.5];
+    for (string, ratio) in ratios.iter().enumerate() {
+        let slot = engine
+            .slots
+            .iter()
+            .find(|slot| slot.key == Some(StringKey::Drone(string)))
+            .unwrap_or_else(|| panic!("string {string} not plucked"));
+        assert_eq!(slot.plucked_at, (string as f64 * beat).ceil() as u64);
+        assert_eq!(slot.fundamental_hz, sa_hz * ratio);
+    }
+    assert_eq!(engine.active_voices(), 6);
+}
