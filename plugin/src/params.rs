@@ -22,6 +22,8 @@
 //! | `gain` | Output gain | dB | −60–24 | 0 | after 2 N = full scale |
 //! | `drone` | Drone | on/off | | off | a held note sets Sa and the strings play the cycle |
 //! | `first` | First string | | Pa, Ma, Ni, komal Ni, Dha | Pa | first drone string: 3/4, 2/3, 15/16, 8/9 or 5/6 of Sa (just intonation) |
+//! | `a4` | Reference A4 | Hz | 415–466 | 440 | the pitch of A4 every note is tuned from |
+//! | `fine` | Fine tuning | cents | −100–100 | 0 | moves every note (and the drone's Sa) |
 //! | `dpat` | Drone strings | | 4, 5, 6 strings | 4 strings | Pa Sa Sa sa; Pa Ni Sa Sa sa; Pa Pa Sa Sa sa sa (with the first string's note for Pa) |
 //! | `dspace` | Pluck spacing | beats | 0.25–4 | 1 | gap after each pluck |
 //! | `dpause` | Cycle pause | beats | 0–8 | 1 | extra gap after the cycle's last pluck |
@@ -45,6 +47,7 @@ use javari_core::engine::drone::{
     DronePattern, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE, HUMANIZE_TIMING_RANGE_S,
     PLUCK_SPACING_RANGE_BEATS, TEMPO_RANGE_BPM,
 };
+use javari_core::engine::pitch::{Tuning, A4_HZ, A4_RANGE_HZ, FINE_TUNE_RANGE_CENTS};
 use javari_core::engine::preset::{
     Preset, BOW_POSITION_RANGE, BOW_VELOCITY_RANGE_M_S, PLUCK_POSITION_RANGE_M,
 };
@@ -215,6 +218,10 @@ pub struct JavariParams {
     pub drone_tempo_sync: BoolParam,
     #[id = "dbpm"]
     pub drone_tempo_bpm: FloatParam,
+    #[id = "a4"]
+    pub reference_a4_hz: FloatParam,
+    #[id = "fine"]
+    pub fine_tune_cents: FloatParam,
     #[id = "dpat"]
     pub drone_pattern: EnumParam<DronePatternChoice>,
     #[id = "dspace"]
@@ -359,6 +366,26 @@ impl Default for JavariParams {
                 },
             )
             .with_unit(" bpm")
+            .with_step_size(0.1),
+            reference_a4_hz: FloatParam::new(
+                "Reference A4",
+                A4_HZ as f32,
+                FloatRange::Linear {
+                    min: A4_RANGE_HZ.0 as f32,
+                    max: A4_RANGE_HZ.1 as f32,
+                },
+            )
+            .with_unit(" Hz")
+            .with_step_size(0.1),
+            fine_tune_cents: FloatParam::new(
+                "Fine tuning",
+                0.0,
+                FloatRange::Linear {
+                    min: FINE_TUNE_RANGE_CENTS.0 as f32,
+                    max: FINE_TUNE_RANGE_CENTS.1 as f32,
+                },
+            )
+            .with_unit(" cents")
             .with_step_size(0.1),
             drone_pattern: EnumParam::new("Drone strings", DronePatternChoice::Four),
             drone_spacing_beats: FloatParam::new(
@@ -513,8 +540,13 @@ impl JavariParams {
             TanpuraOutputChoice::Radiated => TanpuraOutput::Radiated,
             TanpuraOutputChoice::Pickup => TanpuraOutput::Pickup,
         };
+        let tuning = Tuning {
+            a4_hz: f64::from(self.reference_a4_hz.value()),
+            fine_tune_cents: f64::from(self.fine_tune_cents.value()),
+        };
         if let Some(preset) = preset {
             let mut settings = preset.settings;
+            settings.tuning = tuning;
             settings.voice.quality = quality;
             settings.tanpura_output = tanpura_output;
             settings.output_gain_db += gain_db;
@@ -542,6 +574,7 @@ impl JavariParams {
             output_gain_db: gain_db,
             drone: drone_from_knobs,
             tanpura_output,
+            tuning,
             instrument: match self.instrument.value() {
                 InstrumentChoice::Tanpura => Instrument::Tanpura,
                 InstrumentChoice::Bowed => Instrument::Bowed,

@@ -147,6 +147,8 @@ pub struct EngineSettings {
     pub bowed: BowedEngineSettings,
     /// The tanpura's output: pickup forces or the body's radiated sound.
     pub tanpura_output: TanpuraOutput,
+    /// Reference pitch and fine tuning of every note (MIDI notes and the drone's Sa).
+    pub tuning: pitch::Tuning,
 }
 
 impl Default for EngineSettings {
@@ -159,6 +161,7 @@ impl Default for EngineSettings {
             instrument: Instrument::Tanpura,
             bowed: BowedEngineSettings::default(),
             tanpura_output: TanpuraOutput::Pickup,
+            tuning: pitch::Tuning::default(),
         }
     }
 }
@@ -713,7 +716,7 @@ impl Engine {
             EngineEvent::NoteOn { note, velocity } if velocity > 0.0 => {
                 if self.target.drone.enabled {
                     self.drone.note_on(note, self.clock);
-                } else if let Some(hz) = pitch::playable_note_hz(note) {
+                } else if let Some(hz) = self.target.tuning.playable_note_hz(note) {
                     self.pluck_string(StringKey::Note(note), hz, velocity);
                 }
             }
@@ -757,7 +760,7 @@ impl Engine {
             return;
         };
         let (ratios, _) = string_ratios(drone.first_string, drone.pattern);
-        let hz = pitch::note_to_hz(sa_note) * ratios[pluck.string];
+        let hz = self.target.tuning.note_hz(sa_note) * ratios[pluck.string];
         let (low, high) = VoiceSettings::FUNDAMENTAL_RANGE_HZ;
         if (low..=high).contains(&hz) {
             self.pluck_string(StringKey::Drone(pluck.string), hz, pluck.strength as f32);

@@ -24,6 +24,8 @@
 //! | `pluck_width_m` | m | 0.002–0.040 | fingertip width |
 //! | `pluck_amplitude_m` | m | 0–0.005 | finger lift at full velocity |
 //! | `output_gain_db` | dB | −60–24 | output gain |
+//! | `reference_a4_hz` | Hz | 415–466 | the pitch of A4 every note is tuned from |
+//! | `fine_tune_cents` | cents | −100–100 | moves every note (and the drone's Sa) |
 //! | `drone_enabled` | bool | | drone mode |
 //! | `drone_first_string` | text | pa, ma, ni, komal-ni, dha | first drone string (`FirstString`) |
 //! | `drone_pattern` | text | four, five, six | the drone's strings (`drone.rs`) |
@@ -48,6 +50,7 @@ use super::drone::{
     DronePattern, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE, HUMANIZE_TIMING_RANGE_S,
     PLUCK_SPACING_RANGE_BEATS, TEMPO_RANGE_BPM,
 };
+use super::pitch::{A4_RANGE_HZ, FINE_TUNE_RANGE_CENTS};
 use super::{BowedStringKind, EngineSettings, Instrument, TanpuraOutput, OUTPUT_GAIN_RANGE_DB};
 use crate::bowed::BowTier;
 use crate::tanpura::excitation::Pluck;
@@ -145,7 +148,7 @@ impl Kind {
 }
 
 /// Every key and what it takes, in the order of [`PresetFile`] and of the table above.
-const KEYS: [(&str, Kind); 33] = [
+const KEYS: [(&str, Kind); 35] = [
     ("name", Kind::Text),
     (
         "bridge_stiffness_n_m2",
@@ -166,6 +169,8 @@ const KEYS: [(&str, Kind); 33] = [
     ("pluck_width_m", Kind::Number(Pluck::WIDTH_RANGE_M)),
     ("pluck_amplitude_m", Kind::Number(Pluck::AMPLITUDE_RANGE_M)),
     ("output_gain_db", Kind::Number(OUTPUT_GAIN_RANGE_DB)),
+    ("reference_a4_hz", Kind::Number(A4_RANGE_HZ)),
+    ("fine_tune_cents", Kind::Number(FINE_TUNE_RANGE_CENTS)),
     ("drone_enabled", Kind::Switch),
     ("drone_first_string", Kind::Choice(&FIRST_STRING_NAMES)),
     ("drone_pattern", Kind::Choice(&DRONE_PATTERN_NAMES)),
@@ -224,6 +229,8 @@ struct PresetFile {
     pluck_width_m: Option<Spanned<f64>>,
     pluck_amplitude_m: Option<Spanned<f64>>,
     output_gain_db: Option<Spanned<f64>>,
+    reference_a4_hz: Option<Spanned<f64>>,
+    fine_tune_cents: Option<Spanned<f64>>,
     drone_enabled: Option<Spanned<bool>>,
     drone_first_string: Option<Spanned<String>>,
     drone_pattern: Option<Spanned<String>>,
@@ -455,6 +462,14 @@ impl Preset {
             &mut settings.output_gain_db,
             check.number("output_gain_db", read.output_gain_db)?,
         );
+        set(
+            &mut settings.tuning.a4_hz,
+            check.number("reference_a4_hz", read.reference_a4_hz)?,
+        );
+        set(
+            &mut settings.tuning.fine_tune_cents,
+            check.number("fine_tune_cents", read.fine_tune_cents)?,
+        );
         set_switch(&mut settings.drone.enabled, switch(read.drone_enabled));
         if let Some(first) = check.choice("drone_first_string", read.drone_first_string)? {
             let index = FIRST_STRING_NAMES
@@ -563,6 +578,8 @@ impl Preset {
             pluck_width_m: value(s.pluck.width_m),
             pluck_amplitude_m: value(s.pluck.amplitude_m),
             output_gain_db: value(s.output_gain_db),
+            reference_a4_hz: value(s.tuning.a4_hz),
+            fine_tune_cents: value(s.tuning.fine_tune_cents),
             drone_enabled: Some(Spanned::new(0..0, s.drone.enabled)),
             drone_first_string: text(first_string_name(s.drone.first_string)),
             drone_pattern: text(DRONE_PATTERN_NAMES[s.drone.pattern as usize]),
@@ -605,6 +622,8 @@ mod tests {
         preset.settings.drone.pattern = DronePattern::Five;
         preset.settings.drone.humanize_seed = 4_000_000_000;
         preset.settings.drone.humanize_timing_s = 0.012;
+        preset.settings.tuning.a4_hz = 432.5;
+        preset.settings.tuning.fine_tune_cents = -23.0;
         preset.settings.voice.quality = Quality::Studio;
         preset.settings.tanpura_output = TanpuraOutput::Radiated;
         preset.settings.instrument = Instrument::Bowed;

@@ -307,3 +307,23 @@ fn six_string_drone_plucks_every_string_on_the_host_beat_to_the_sample() {
     }
     assert_eq!(engine.active_voices(), 6);
 }
+
+#[test]
+fn reference_pitch_and_fine_tuning_tune_notes_and_the_drone() {
+    let mut settings = EngineSettings::default();
+    settings.tuning = pitch::Tuning {
+        a4_hz: 415.0,
+        fine_tune_cents: 25.0,
+    };
+    let expected = |note: u8| 415.0 * ((f64::from(note) - 69.0) / 12.0 + 25.0 / 1200.0).exp2();
+    let mut engine = Engine::new(&settings, RATE, 2);
+    run(&mut engine, &[note_on(0, 57)], 64);
+    let played = engine.slots.iter().find(|slot| slot.key.is_some()).unwrap();
+    assert!((played.fundamental_hz / expected(57) - 1.0).abs() < 1e-12);
+
+    settings.drone.enabled = true;
+    let mut drone = Engine::new(&settings, RATE, 4);
+    run(&mut drone, &[note_on(0, 50)], 64);
+    let first = drone.slots.iter().find(|slot| slot.key.is_some()).unwrap();
+    assert!((first.fundamental_hz / (0.75 * expected(50)) - 1.0).abs() < 1e-12);
+}

@@ -110,6 +110,10 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
                 "On: the drone cycle follows the host's tempo. Off: it uses the drone tempo below.");
             row(ui, setter, &params.drone_tempo_bpm,
                 "Tempo of the drone cycle when not synced to the host, beats per minute.");
+            row(ui, setter, &params.reference_a4_hz,
+                "The pitch of A4 every note is tuned from (440 Hz; 415 to 466 Hz for other concert pitches).");
+            row(ui, setter, &params.fine_tune_cents,
+                "Moves every note, and so the drone's Sa, by up to a semitone: tune the drone to a voice or an instrument between two keys.");
             row(ui, setter, &params.drone_pattern,
                 "How many strings: 4 (first, Sa, Sa, low Sa), 5 (first, Ni, Sa, Sa, low Sa) or 6 (first, first, Sa, Sa, low Sa, low Sa).");
             row(ui, setter, &params.drone_spacing_beats,
