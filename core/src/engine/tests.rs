@@ -310,10 +310,12 @@ fn six_string_drone_plucks_every_string_on_the_host_beat_to_the_sample() {
 
 #[test]
 fn reference_pitch_and_fine_tuning_tune_notes_and_the_drone() {
-    let mut settings = EngineSettings::default();
-    settings.tuning = pitch::Tuning {
-        a4_hz: 415.0,
-        fine_tune_cents: 25.0,
+    let mut settings = EngineSettings {
+        tuning: pitch::Tuning {
+            a4_hz: 415.0,
+            fine_tune_cents: 25.0,
+        },
+        ..EngineSettings::default()
     };
     let expected = |note: u8| 415.0 * ((f64::from(note) - 69.0) / 12.0 + 25.0 / 1200.0).exp2();
     let mut engine = Engine::new(&settings, RATE, 2);
