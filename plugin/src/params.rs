@@ -16,11 +16,20 @@
 //! | `plpos` | Pluck position | mm | 50–600 | 350 | pluck point from the tuning bead |
 //! | `plwid` | Pluck width | mm | 2–40 | 10 | fingertip width |
 //! | `plamp` | Pluck amplitude | mm | 0–5 | 2 | finger lift at full velocity |
-//! | `pick` | Pickup | % nut | 0–100 | 100 | 100: nut force, 0: bridge force |
+//! | `tout` | Tanpura output | | Radiated, Pickup | Radiated | the body's radiated sound (the total bridge force through the tanpura body of `core/src/tanpura/body.rs`), or the pickup forces below |
+//! | `pick` | Pickup | % nut | 0–100 | 100 | with output Pickup: 100: nut force, 0: bridge force |
 //! | `qual` | Quality | | Draft, Live, Studio, Reference | Live | the core's tiers (`core/src/quality.rs`); not part of the factory presets |
 //! | `gain` | Output gain | dB | −60–24 | 0 | after 2 N = full scale |
 //! | `drone` | Drone | on/off | | off | a held note sets Sa and the strings play the cycle |
-//! | `first` | First string | | Pa, Ma, Ni | Pa | first drone string: 3/4, 2/3 or 15/16 of Sa |
+//! | `first` | First string | | Pa, Ma, Ni, komal Ni, Dha | Pa | first drone string: 3/4, 2/3, 15/16, 8/9 or 5/6 of Sa (just intonation) |
+//! | `a4` | Reference A4 | Hz | 415–466 | 440 | the pitch of A4 every note is tuned from |
+//! | `fine` | Fine tuning | cents | −100–100 | 0 | moves every note (and the drone's Sa) |
+//! | `dpat` | Drone strings | | 4, 5, 6 strings | 4 strings | Pa Sa Sa sa; Pa Ni Sa Sa sa; Pa Pa Sa Sa sa sa (with the first string's note for Pa) |
+//! | `dspace` | Pluck spacing | beats | 0.25–4 | 1 | gap after each pluck |
+//! | `dpause` | Cycle pause | beats | 0–8 | 1 | extra gap after the cycle's last pluck |
+//! | `dhtime` | Humanise timing | ms | 0–50 | 0 | largest displacement of a pluck |
+//! | `dhstr` | Humanise strength | % | 0–50 | 0 | largest softening of a pluck |
+//! | `dseed` | Humanise seed | | 0–9999 | 0 | the same seed plays the same way |
 //! | `dsync` | Drone tempo sync | on/off | | on | follow the host's tempo |
 //! | `dbpm` | Drone tempo | bpm | 20–300 | 60 | tempo without sync |
 //! | `inst` | Instrument | | Tanpura, Bowed | Tanpura | plucked tanpura strings or one bowed string |
@@ -34,12 +43,17 @@
 //! | `body` | Body | on/off | | on | the violin-body resonance filter |
 
 use javari_core::bowed::{BowTier, BowedPlayerSettings};
-use javari_core::engine::drone::TEMPO_RANGE_BPM;
+use javari_core::engine::drone::{
+    DronePattern, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE, HUMANIZE_TIMING_RANGE_S,
+    PLUCK_SPACING_RANGE_BEATS, TEMPO_RANGE_BPM,
+};
+use javari_core::engine::pitch::{Tuning, A4_HZ, A4_RANGE_HZ, FINE_TUNE_RANGE_CENTS};
 use javari_core::engine::preset::{
     Preset, BOW_POSITION_RANGE, BOW_VELOCITY_RANGE_M_S, PLUCK_POSITION_RANGE_M,
 };
 use javari_core::engine::{
-    BowedEngineSettings, BowedStringKind, EngineSettings, Instrument, OUTPUT_GAIN_RANGE_DB,
+    BowedEngineSettings, BowedStringKind, EngineSettings, Instrument, TanpuraOutput,
+    OUTPUT_GAIN_RANGE_DB,
 };
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::geometry::ThreadSettings;
@@ -118,6 +132,15 @@ pub enum QualityChoice {
     Reference,
 }
 
+/// What the tanpura's output is (`javari_core::engine::TanpuraOutput`).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TanpuraOutputChoice {
+    #[id = "radiated"]
+    Radiated,
+    #[id = "pickup"]
+    Pickup,
+}
+
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FirstStringChoice {
     #[id = "pa"]
@@ -126,6 +149,25 @@ pub enum FirstStringChoice {
     Ma,
     #[id = "ni"]
     Ni,
+    #[id = "komal-ni"]
+    #[name = "komal Ni"]
+    KomalNi,
+    #[id = "dha"]
+    Dha,
+}
+
+/// The drone's strings (`javari_core::engine::drone::DronePattern`).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DronePatternChoice {
+    #[id = "four"]
+    #[name = "4 strings"]
+    Four,
+    #[id = "five"]
+    #[name = "5 strings"]
+    Five,
+    #[id = "six"]
+    #[name = "6 strings"]
+    Six,
 }
 
 const MM_PER_M: f64 = 1000.0;
@@ -160,6 +202,8 @@ pub struct JavariParams {
     pub pluck_width_mm: FloatParam,
     #[id = "plamp"]
     pub pluck_amplitude_mm: FloatParam,
+    #[id = "tout"]
+    pub tanpura_output: EnumParam<TanpuraOutputChoice>,
     #[id = "pick"]
     pub nut_pickup_percent: FloatParam,
     #[id = "qual"]
@@ -174,6 +218,22 @@ pub struct JavariParams {
     pub drone_tempo_sync: BoolParam,
     #[id = "dbpm"]
     pub drone_tempo_bpm: FloatParam,
+    #[id = "a4"]
+    pub reference_a4_hz: FloatParam,
+    #[id = "fine"]
+    pub fine_tune_cents: FloatParam,
+    #[id = "dpat"]
+    pub drone_pattern: EnumParam<DronePatternChoice>,
+    #[id = "dspace"]
+    pub drone_spacing_beats: FloatParam,
+    #[id = "dpause"]
+    pub drone_pause_beats: FloatParam,
+    #[id = "dhtime"]
+    pub drone_humanize_ms: FloatParam,
+    #[id = "dhstr"]
+    pub drone_humanize_percent: FloatParam,
+    #[id = "dseed"]
+    pub drone_seed: IntParam,
     #[id = "inst"]
     pub instrument: EnumParam<InstrumentChoice>,
     #[id = "bmodel"]
@@ -283,6 +343,7 @@ impl Default for JavariParams {
             .with_step_size(0.1),
             // Live by default: a DAW needs real time; the renderer defaults to Reference.
             quality: EnumParam::new("Quality", QualityChoice::Live),
+            tanpura_output: EnumParam::new("Tanpura output", TanpuraOutputChoice::Radiated),
             output_gain_db: FloatParam::new(
                 "Output gain",
                 0.0,
@@ -306,6 +367,68 @@ impl Default for JavariParams {
             )
             .with_unit(" bpm")
             .with_step_size(0.1),
+            reference_a4_hz: FloatParam::new(
+                "Reference A4",
+                A4_HZ as f32,
+                FloatRange::Linear {
+                    min: A4_RANGE_HZ.0 as f32,
+                    max: A4_RANGE_HZ.1 as f32,
+                },
+            )
+            .with_unit(" Hz")
+            .with_step_size(0.1),
+            fine_tune_cents: FloatParam::new(
+                "Fine tuning",
+                0.0,
+                FloatRange::Linear {
+                    min: FINE_TUNE_RANGE_CENTS.0 as f32,
+                    max: FINE_TUNE_RANGE_CENTS.1 as f32,
+                },
+            )
+            .with_unit(" cents")
+            .with_step_size(0.1),
+            drone_pattern: EnumParam::new("Drone strings", DronePatternChoice::Four),
+            drone_spacing_beats: FloatParam::new(
+                "Pluck spacing",
+                1.0,
+                FloatRange::Linear {
+                    min: PLUCK_SPACING_RANGE_BEATS.0 as f32,
+                    max: PLUCK_SPACING_RANGE_BEATS.1 as f32,
+                },
+            )
+            .with_unit(" beats")
+            .with_step_size(0.05),
+            drone_pause_beats: FloatParam::new(
+                "Cycle pause",
+                1.0,
+                FloatRange::Linear {
+                    min: CYCLE_PAUSE_RANGE_BEATS.0 as f32,
+                    max: CYCLE_PAUSE_RANGE_BEATS.1 as f32,
+                },
+            )
+            .with_unit(" beats")
+            .with_step_size(0.05),
+            drone_humanize_ms: FloatParam::new(
+                "Humanise timing",
+                0.0,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: (HUMANIZE_TIMING_RANGE_S.1 * 1000.0) as f32,
+                },
+            )
+            .with_unit(" ms")
+            .with_step_size(0.5),
+            drone_humanize_percent: FloatParam::new(
+                "Humanise strength",
+                0.0,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: (HUMANIZE_STRENGTH_RANGE.1 * 100.0) as f32,
+                },
+            )
+            .with_unit(" %")
+            .with_step_size(1.0),
+            drone_seed: IntParam::new("Humanise seed", 0, IntRange::Linear { min: 0, max: 9999 }),
             instrument: EnumParam::new("Instrument", InstrumentChoice::Tanpura),
             bow_model: EnumParam::new("Bow model", BowModelChoice::RoundedCorner),
             bowed_string: EnumParam::new("Bowed string", BowedStringChoice::ViolinA),
@@ -380,9 +503,21 @@ impl JavariParams {
                 FirstStringChoice::Pa => FirstString::Pa,
                 FirstStringChoice::Ma => FirstString::Ma,
                 FirstStringChoice::Ni => FirstString::Ni,
+                FirstStringChoice::KomalNi => FirstString::KomalNi,
+                FirstStringChoice::Dha => FirstString::Dha,
+            },
+            pattern: match self.drone_pattern.value() {
+                DronePatternChoice::Four => DronePattern::Four,
+                DronePatternChoice::Five => DronePattern::Five,
+                DronePatternChoice::Six => DronePattern::Six,
             },
             tempo_sync: self.drone_tempo_sync.value(),
             free_tempo_bpm: f64::from(self.drone_tempo_bpm.value()),
+            pluck_spacing_beats: f64::from(self.drone_spacing_beats.value()),
+            cycle_pause_beats: f64::from(self.drone_pause_beats.value()),
+            humanize_timing_s: f64::from(self.drone_humanize_ms.value()) / 1000.0,
+            humanize_strength: f64::from(self.drone_humanize_percent.value()) / 100.0,
+            humanize_seed: self.drone_seed.value().max(0) as u32,
         };
         let preset = match self.preset.value() {
             PresetChoice::Custom => None,
@@ -401,9 +536,19 @@ impl JavariParams {
             QualityChoice::Studio => Quality::Studio,
             QualityChoice::Reference => Quality::Reference,
         };
+        let tanpura_output = match self.tanpura_output.value() {
+            TanpuraOutputChoice::Radiated => TanpuraOutput::Radiated,
+            TanpuraOutputChoice::Pickup => TanpuraOutput::Pickup,
+        };
+        let tuning = Tuning {
+            a4_hz: f64::from(self.reference_a4_hz.value()),
+            fine_tune_cents: f64::from(self.fine_tune_cents.value()),
+        };
         if let Some(preset) = preset {
             let mut settings = preset.settings;
+            settings.tuning = tuning;
             settings.voice.quality = quality;
+            settings.tanpura_output = tanpura_output;
             settings.output_gain_db += gain_db;
             settings.drone = drone_from_knobs;
             return settings;
@@ -428,6 +573,8 @@ impl JavariParams {
             },
             output_gain_db: gain_db,
             drone: drone_from_knobs,
+            tanpura_output,
+            tuning,
             instrument: match self.instrument.value() {
                 InstrumentChoice::Tanpura => Instrument::Tanpura,
                 InstrumentChoice::Bowed => Instrument::Bowed,

@@ -17,7 +17,7 @@ use javari_core::analysis::{
     band_power, cents, peak_frequency_hz, power_spectrum, spectral_centroid_hz,
 };
 use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
-use javari_core::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
+use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
 use javari_core::newton::NewtonStats;
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
@@ -414,7 +414,8 @@ pub struct EconomyRow {
 }
 
 /// A one-string pluck in the four-string instrument (three strings asleep), a string without
-/// thread, and a string with no barrier at all, each against the plain one-string scene.
+/// thread, and a string with no barrier at all, each against the plain one-string scene; and the
+/// eight-voices scene with and without the tanpura body (what the radiated output costs).
 pub fn run_economy(seconds: f64) -> Vec<EconomyRow> {
     let live = settings_at(Quality::Live);
     let row = |scene: &mut dyn Scene, name: &'static str, note: &'static str| {
@@ -461,6 +462,28 @@ pub fn run_economy(seconds: f64) -> Vec<EconomyRow> {
         "no barrier",
         "nothing near contact: every step skips Newton",
     ));
+    for (output, name, note) in [
+        (
+            TanpuraOutput::Pickup,
+            "eight voices, pickup output",
+            "the eight-voices scene as the bench plays it",
+        ),
+        (
+            TanpuraOutput::Radiated,
+            "eight voices, radiated output",
+            "the same through the tanpura body (18 resonators on the summed bridge force)",
+        ),
+    ] {
+        let engine_settings = EngineSettings {
+            voice: live,
+            tanpura_output: output,
+            ..EngineSettings::default()
+        };
+        let mut voices = EightVoices {
+            engine: Engine::new(&engine_settings, SAMPLE_RATE, 8),
+        };
+        rows.push(row(&mut voices, name, note));
+    }
     rows
 }
 

@@ -39,6 +39,7 @@ pub mod smoothing;
 pub mod wav;
 
 use crate::bowed::{BowedEvent, BowedInstrument, BowedPlayerSettings, StringConstants};
+use crate::tanpura::body::{Body, TANPURA_BODY};
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
 use drone::{string_ratios, DroneSequencer, DroneSettings};
@@ -123,6 +124,19 @@ impl Default for BowedEngineSettings {
     }
 }
 
+/// What the tanpura's output is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TanpuraOutput {
+    /// The strings' forces at the nut and the bridge, mixed by
+    /// [`VoiceSettings::nut_pickup_weight`] (1: the nut force, the seed's signal; 0: the bridge
+    /// force).
+    #[default]
+    Pickup,
+    /// The sound the body radiates: the total bridge force of all strings through the body's
+    /// resonances (`tanpura/body.rs`, fitted to the response measured in DAFx-16).
+    Radiated,
+}
+
 /// Everything the engine plays with, in SI units (normalised mappings live in the plugin).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EngineSettings {
@@ -136,6 +150,10 @@ pub struct EngineSettings {
     pub drone: DroneSettings,
     pub instrument: Instrument,
     pub bowed: BowedEngineSettings,
+    /// The tanpura's output: pickup forces or the body's radiated sound.
+    pub tanpura_output: TanpuraOutput,
+    /// Reference pitch and fine tuning of every note (MIDI notes and the drone's Sa).
+    pub tuning: pitch::Tuning,
 }
 
 impl Default for EngineSettings {
@@ -147,6 +165,8 @@ impl Default for EngineSettings {
             drone: DroneSettings::default(),
             instrument: Instrument::Tanpura,
             bowed: BowedEngineSettings::default(),
+            tanpura_output: TanpuraOutput::Pickup,
+            tuning: pitch::Tuning::default(),
         }
     }
 }
@@ -409,6 +429,8 @@ pub struct Engine {
     applied_bow_controls: Option<(f64, f64, f64)>,
     /// One buffer per voice for [`Engine::process_with`] (empty until it is used).
     scratch: Vec<Vec<f32>>,
+    /// The tanpura's body, between the strings' total bridge force and the output.
+    body: Body,
 }
 
 /// `ln(1 + k_b)`: stiffness ramps in a logarithmic domain (its range spans twelve decades) that
@@ -475,6 +497,7 @@ impl Engine {
                 .collect(),
             applied_bow_controls: None,
             scratch: Vec::new(),
+            body: Body::new(&TANPURA_BODY, sample_rate_hz),
         };
         engine.apply_bowed_settings();
         engine
@@ -624,6 +647,7 @@ impl Engine {
             slot.plucked_at = 0;
         }
         self.drone.reset();
+        self.body.reset();
         self.clock = 0;
         self.next_control_tick = 0;
         for instrument in &mut self.bowed {
@@ -682,7 +706,10 @@ impl Engine {
                 end = end.min(timed.offset.min(length - 1));
             }
             end = end.min(position + (self.next_control_tick - self.clock) as usize);
-            if let Some(pluck_sample) = self.drone.next_pluck_sample() {
+            if let Some(pluck_sample) = self
+                .drone
+                .next_pluck_sample(&self.target.drone, self.sample_rate_hz)
+            {
                 let until = pluck_sample.saturating_sub(self.clock).max(1);
                 end = end.min(position + until.min(length as u64) as usize);
             }
@@ -742,6 +769,15 @@ impl Engine {
                 }
             }
         }
+        if self.target.instrument == Instrument::Tanpura
+            && self.target.tanpura_output == TanpuraOutput::Radiated
+        {
+            // The strings' outputs are their bridge forces here (`control_tick`), summed: the
+            // body is driven by the total force on the bridge.
+            for sample in output.iter_mut() {
+                *sample = self.body.tick(f64::from(*sample)) as f32;
+            }
+        }
         for sample in output.iter_mut() {
             *sample *= self.output_gain.step() as f32;
         }
@@ -756,6 +792,10 @@ impl Engine {
         settings.gamma_per_s = self.gamma.step();
         settings.eta_s = self.eta.step();
         settings.nut_pickup_weight = self.pickup_weight.step();
+        if self.target.tanpura_output == TanpuraOutput::Radiated {
+            // The body hears the bridge.
+            settings.nut_pickup_weight = 0.0;
+        }
         settings.fundamental_hz = self.current_voice.fundamental_hz;
         if settings == self.current_voice {
             return;
@@ -810,7 +850,7 @@ impl Engine {
             EngineEvent::NoteOn { note, velocity } if velocity > 0.0 => {
                 if self.target.drone.enabled {
                     self.drone.note_on(note, self.clock);
-                } else if let Some(hz) = pitch::playable_note_hz(note) {
+                } else if let Some(hz) = self.target.tuning.playable_note_hz(note) {
                     self.pluck_string(StringKey::Note(note), hz, velocity);
                 }
             }
@@ -844,19 +884,20 @@ impl Engine {
             (true, Some(host)) => host,
             _ => drone.free_tempo_bpm,
         };
-        let Some(string) = self
+        let Some(pluck) = self
             .drone
-            .take_due_pluck(self.clock, tempo, self.sample_rate_hz)
+            .take_due_pluck(self.clock, &drone, tempo, self.sample_rate_hz)
         else {
             return;
         };
         let Some(sa_note) = self.drone.sa_note() else {
             return;
         };
-        let hz = pitch::note_to_hz(sa_note) * string_ratios(drone.first_string)[string];
+        let (ratios, _) = string_ratios(drone.first_string, drone.pattern);
+        let hz = self.target.tuning.note_hz(sa_note) * ratios[pluck.string];
         let (low, high) = VoiceSettings::FUNDAMENTAL_RANGE_HZ;
         if (low..=high).contains(&hz) {
-            self.pluck_string(StringKey::Drone(string), hz, 1.0);
+            self.pluck_string(StringKey::Drone(pluck.string), hz, pluck.strength as f32);
         }
     }
 

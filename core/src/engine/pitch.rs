@@ -1,6 +1,8 @@
-//! MIDI note numbers to string pitch: twelve-tone equal temperament with A4 (note 69) = 440 Hz.
+//! MIDI note numbers to string pitch: twelve-tone equal temperament with A4 (note 69) = 440 Hz,
+//! or any reference pitch and fine tuning a player sets ([`Tuning`]).
 //!
-//! `f = 440 Hz · 2^((n − 69)/12)`. Notes whose pitch falls outside the tanpura voice's range
+//! `f = A4 · 2^((n − 69)/12 + c/1200)`, A4 = 415–466 Hz (baroque to high modern pitch), the fine
+//! tuning c = ±100 cents (so Sa can sit anywhere between two notes). Notes whose pitch falls outside the tanpura voice's range
 //! ([`VoiceSettings::FUNDAMENTAL_RANGE_HZ`], 20–2000 Hz, i.e. notes 16 to 95) are not played:
 //! a string tuned outside that range is not the instrument any more.
 
@@ -11,7 +13,52 @@ pub const A4_HZ: f64 = 440.0;
 /// MIDI note number of A4.
 pub const A4_NOTE: u8 = 69;
 
-/// The equal-tempered pitch of a MIDI note, Hz.
+/// Valid reference pitch range, Hz, and fine tuning range, cents.
+pub const A4_RANGE_HZ: (f64, f64) = (415.0, 466.0);
+pub const FINE_TUNE_RANGE_CENTS: (f64, f64) = (-100.0, 100.0);
+
+/// How MIDI notes become pitches: the reference pitch of A4 and a fine tuning of every note.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tuning {
+    pub a4_hz: f64,
+    pub fine_tune_cents: f64,
+}
+
+impl Default for Tuning {
+    fn default() -> Self {
+        Self {
+            a4_hz: A4_HZ,
+            fine_tune_cents: 0.0,
+        }
+    }
+}
+
+impl Tuning {
+    /// The pitch of `note`, Hz (values outside the ranges are clamped; NaN takes the default).
+    pub fn note_hz(&self, note: u8) -> f64 {
+        let a4 = if self.a4_hz.is_nan() {
+            A4_HZ
+        } else {
+            self.a4_hz.clamp(A4_RANGE_HZ.0, A4_RANGE_HZ.1)
+        };
+        let cents = if self.fine_tune_cents.is_nan() {
+            0.0
+        } else {
+            self.fine_tune_cents
+                .clamp(FINE_TUNE_RANGE_CENTS.0, FINE_TUNE_RANGE_CENTS.1)
+        };
+        a4 * ((f64::from(note) - f64::from(A4_NOTE)) / 12.0 + cents / 1200.0).exp2()
+    }
+
+    /// [`Tuning::note_hz`] if a tanpura string can be tuned there.
+    pub fn playable_note_hz(&self, note: u8) -> Option<f64> {
+        let hz = self.note_hz(note);
+        let (low, high) = VoiceSettings::FUNDAMENTAL_RANGE_HZ;
+        (low..=high).contains(&hz).then_some(hz)
+    }
+}
+
+/// The equal-tempered pitch of a MIDI note at A4 = 440 Hz, Hz.
 pub fn note_to_hz(note: u8) -> f64 {
     A4_HZ * ((f64::from(note) - f64::from(A4_NOTE)) / 12.0).exp2()
 }
@@ -47,6 +94,29 @@ mod tests {
         assert!(playable_note_hz(16).is_some()); // 20.6 Hz
         assert!(playable_note_hz(95).is_some()); // 1975.5 Hz
         assert!(playable_note_hz(96).is_none()); // 2093.0 Hz
+    }
+
+    #[test]
+    fn reference_pitch_and_fine_tuning_move_every_note() {
+        let baroque = Tuning {
+            a4_hz: 415.0,
+            fine_tune_cents: 0.0,
+        };
+        assert_eq!(baroque.note_hz(69), 415.0);
+        // 415 Hz is 101.4 cents below 440 Hz, for every note.
+        let shift = 1200.0 * (415.0f64 / 440.0).log2();
+        assert!((cents(baroque.note_hz(48), note_to_hz(48)) - shift).abs() < 1e-9);
+        let raised = Tuning {
+            a4_hz: 440.0,
+            fine_tune_cents: 37.0,
+        };
+        assert!((cents(raised.note_hz(50), note_to_hz(50)) - 37.0).abs() < 1e-9);
+        assert_eq!(Tuning::default().note_hz(60), note_to_hz(60));
+        let wild = Tuning {
+            a4_hz: f64::NAN,
+            fine_tune_cents: 1e9,
+        };
+        assert!((cents(wild.note_hz(60), note_to_hz(60)) - 100.0).abs() < 1e-9);
     }
 
     #[test]

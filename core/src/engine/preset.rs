@@ -17,16 +17,25 @@
 //! | `bridge_beyond_thread` | bool | | false: no bridge contact past the thread |
 //! | `gamma_per_s` | 1/s | 0–20 | frequency-independent loss γ |
 //! | `eta_s` | s | 0–1e-6 | frequency-dependent loss η |
-//! | `nut_pickup_weight` | 1 | 0–1 | 1: nut force, 0: bridge force |
+//! | `nut_pickup_weight` | 1 | 0–1 | with output pickup: 1: nut force, 0: bridge force |
+//! | `tanpura_output` | text | pickup, radiated | the pickup forces, or the body's radiated sound |
 //! | `quality` | text | draft, live, studio, reference | speed against accuracy (`quality.rs`) |
 //! | `pluck_position_m` | m | 0.05–0.6 | pluck point from the tuning bead |
 //! | `pluck_width_m` | m | 0.002–0.040 | fingertip width |
 //! | `pluck_amplitude_m` | m | 0–0.005 | finger lift at full velocity |
 //! | `output_gain_db` | dB | −60–24 | output gain |
+//! | `reference_a4_hz` | Hz | 415–466 | the pitch of A4 every note is tuned from |
+//! | `fine_tune_cents` | cents | −100–100 | moves every note (and the drone's Sa) |
 //! | `drone_enabled` | bool | | drone mode |
-//! | `drone_first_string` | text | pa, ma, ni | first drone string |
+//! | `drone_first_string` | text | pa, ma, ni, komal-ni, dha | first drone string (`FirstString`) |
+//! | `drone_pattern` | text | four, five, six | the drone's strings (`drone.rs`) |
 //! | `drone_tempo_sync` | bool | | follow the host tempo |
 //! | `drone_tempo_bpm` | 1/min | 20–300 | tempo without sync |
+//! | `drone_pluck_spacing_beats` | beats | 0.25–4 | gap after each pluck |
+//! | `drone_cycle_pause_beats` | beats | 0–8 | extra gap after the cycle's last pluck |
+//! | `drone_humanize_timing_s` | s | 0–0.05 | largest timing displacement of a pluck |
+//! | `drone_humanize_strength` | 1 | 0–0.5 | largest softening of a pluck |
+//! | `drone_humanize_seed` | 1 | 0–4294967295 | the humanisation's seed (whole number) |
 //! | `instrument` | text | tanpura, bowed | which instrument plays |
 //! | `bow_model` | text | rounded-corner, bow-table | the bowed tier |
 //! | `bow_string` | text | violin-a, cello-d | the bowed string's constants |
@@ -37,8 +46,12 @@
 //! | `bow_vibrato_cents` | cents | 0–100 | vibrato depth at full modulation wheel |
 //! | `bow_body` | bool | | the body resonance filter |
 
-use super::drone::TEMPO_RANGE_BPM;
-use super::{BowedStringKind, EngineSettings, Instrument, OUTPUT_GAIN_RANGE_DB};
+use super::drone::{
+    DronePattern, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE, HUMANIZE_TIMING_RANGE_S,
+    PLUCK_SPACING_RANGE_BEATS, TEMPO_RANGE_BPM,
+};
+use super::pitch::{A4_RANGE_HZ, FINE_TUNE_RANGE_CENTS};
+use super::{BowedStringKind, EngineSettings, Instrument, TanpuraOutput, OUTPUT_GAIN_RANGE_DB};
 use crate::bowed::BowTier;
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::geometry::ThreadSettings;
@@ -67,15 +80,20 @@ pub const BOW_POSITION_RANGE: (f64, f64) = (0.02, 0.5);
 pub const BOW_GLIDE_RANGE_S: (f64, f64) = (0.0, 1.0);
 pub const BOW_VIBRATO_RANGE_CENTS: (f64, f64) = (0.0, 100.0);
 
+/// Names of the tanpura's outputs ([`TanpuraOutput`]), as written in presets.
+pub const TANPURA_OUTPUT_NAMES: [&str; 2] = ["pickup", "radiated"];
+
 /// Names of the first drone string's choices, as written in presets.
-pub const FIRST_STRING_NAMES: [&str; 3] = ["pa", "ma", "ni"];
+pub const FIRST_STRING_NAMES: [&str; 5] = ["pa", "ma", "ni", "komal-ni", "dha"];
+/// Names of the drone patterns, as written in presets.
+pub const DRONE_PATTERN_NAMES: [&str; 3] = ["four", "five", "six"];
 
 fn first_string_name(first: FirstString) -> &'static str {
-    match first {
-        FirstString::Pa => "pa",
-        FirstString::Ma => "ma",
-        FirstString::Ni => "ni",
-    }
+    let index = FirstString::ALL
+        .iter()
+        .position(|candidate| *candidate == first)
+        .unwrap_or(0);
+    FIRST_STRING_NAMES[index]
 }
 
 /// A named set of engine settings.
@@ -133,7 +151,7 @@ impl Kind {
 }
 
 /// Every key and what it takes, in the order of [`PresetFile`] and of the table above.
-const KEYS: [(&str, Kind); 26] = [
+const KEYS: [(&str, Kind); 35] = [
     ("name", Kind::Text),
     (
         "bridge_stiffness_n_m2",
@@ -148,15 +166,36 @@ const KEYS: [(&str, Kind); 26] = [
     ("gamma_per_s", Kind::Number(VoiceSettings::GAMMA_RANGE)),
     ("eta_s", Kind::Number(VoiceSettings::ETA_RANGE)),
     ("nut_pickup_weight", Kind::Number((0.0, 1.0))),
+    ("tanpura_output", Kind::Choice(&TANPURA_OUTPUT_NAMES)),
     ("quality", Kind::Choice(&QUALITY_NAMES)),
     ("pluck_position_m", Kind::Number(PLUCK_POSITION_RANGE_M)),
     ("pluck_width_m", Kind::Number(Pluck::WIDTH_RANGE_M)),
     ("pluck_amplitude_m", Kind::Number(Pluck::AMPLITUDE_RANGE_M)),
     ("output_gain_db", Kind::Number(OUTPUT_GAIN_RANGE_DB)),
+    ("reference_a4_hz", Kind::Number(A4_RANGE_HZ)),
+    ("fine_tune_cents", Kind::Number(FINE_TUNE_RANGE_CENTS)),
     ("drone_enabled", Kind::Switch),
     ("drone_first_string", Kind::Choice(&FIRST_STRING_NAMES)),
+    ("drone_pattern", Kind::Choice(&DRONE_PATTERN_NAMES)),
     ("drone_tempo_sync", Kind::Switch),
     ("drone_tempo_bpm", Kind::Number(TEMPO_RANGE_BPM)),
+    (
+        "drone_pluck_spacing_beats",
+        Kind::Number(PLUCK_SPACING_RANGE_BEATS),
+    ),
+    (
+        "drone_cycle_pause_beats",
+        Kind::Number(CYCLE_PAUSE_RANGE_BEATS),
+    ),
+    (
+        "drone_humanize_timing_s",
+        Kind::Number(HUMANIZE_TIMING_RANGE_S),
+    ),
+    (
+        "drone_humanize_strength",
+        Kind::Number(HUMANIZE_STRENGTH_RANGE),
+    ),
+    ("drone_humanize_seed", Kind::Number((0.0, 4_294_967_295.0))),
     ("instrument", Kind::Choice(&INSTRUMENT_NAMES)),
     ("bow_model", Kind::Choice(&BOW_MODEL_NAMES)),
     ("bow_string", Kind::Choice(&BOW_STRING_NAMES)),
@@ -187,15 +226,24 @@ struct PresetFile {
     gamma_per_s: Option<Spanned<f64>>,
     eta_s: Option<Spanned<f64>>,
     nut_pickup_weight: Option<Spanned<f64>>,
+    tanpura_output: Option<Spanned<String>>,
     quality: Option<Spanned<String>>,
     pluck_position_m: Option<Spanned<f64>>,
     pluck_width_m: Option<Spanned<f64>>,
     pluck_amplitude_m: Option<Spanned<f64>>,
     output_gain_db: Option<Spanned<f64>>,
+    reference_a4_hz: Option<Spanned<f64>>,
+    fine_tune_cents: Option<Spanned<f64>>,
     drone_enabled: Option<Spanned<bool>>,
     drone_first_string: Option<Spanned<String>>,
+    drone_pattern: Option<Spanned<String>>,
     drone_tempo_sync: Option<Spanned<bool>>,
     drone_tempo_bpm: Option<Spanned<f64>>,
+    drone_pluck_spacing_beats: Option<Spanned<f64>>,
+    drone_cycle_pause_beats: Option<Spanned<f64>>,
+    drone_humanize_timing_s: Option<Spanned<f64>>,
+    drone_humanize_strength: Option<Spanned<f64>>,
+    drone_humanize_seed: Option<Spanned<f64>>,
     instrument: Option<Spanned<String>>,
     bow_model: Option<Spanned<String>>,
     bow_string: Option<Spanned<String>>,
@@ -391,6 +439,13 @@ impl Preset {
             &mut voice.nut_pickup_weight,
             check.number("nut_pickup_weight", read.nut_pickup_weight)?,
         );
+        if let Some(output) = check.choice("tanpura_output", read.tanpura_output)? {
+            settings.tanpura_output = match output {
+                "radiated" => TanpuraOutput::Radiated,
+                _ => TanpuraOutput::Pickup,
+            };
+        }
+        let voice = &mut settings.voice;
         if let Some(name) = check.choice("quality", read.quality)? {
             voice.quality = Quality::from_name(name).expect("QUALITY_NAMES are the tiers' names");
         }
@@ -410,13 +465,28 @@ impl Preset {
             &mut settings.output_gain_db,
             check.number("output_gain_db", read.output_gain_db)?,
         );
+        set(
+            &mut settings.tuning.a4_hz,
+            check.number("reference_a4_hz", read.reference_a4_hz)?,
+        );
+        set(
+            &mut settings.tuning.fine_tune_cents,
+            check.number("fine_tune_cents", read.fine_tune_cents)?,
+        );
         set_switch(&mut settings.drone.enabled, switch(read.drone_enabled));
         if let Some(first) = check.choice("drone_first_string", read.drone_first_string)? {
-            settings.drone.first_string = match first {
-                "ma" => FirstString::Ma,
-                "ni" => FirstString::Ni,
-                _ => FirstString::Pa,
-            };
+            let index = FIRST_STRING_NAMES
+                .iter()
+                .position(|name| *name == first)
+                .unwrap_or(0);
+            settings.drone.first_string = FirstString::ALL[index];
+        }
+        if let Some(pattern) = check.choice("drone_pattern", read.drone_pattern)? {
+            let index = DRONE_PATTERN_NAMES
+                .iter()
+                .position(|name| *name == pattern)
+                .unwrap_or(0);
+            settings.drone.pattern = DronePattern::ALL[index];
         }
         set_switch(
             &mut settings.drone.tempo_sync,
@@ -426,6 +496,26 @@ impl Preset {
             &mut settings.drone.free_tempo_bpm,
             check.number("drone_tempo_bpm", read.drone_tempo_bpm)?,
         );
+        set(
+            &mut settings.drone.pluck_spacing_beats,
+            check.number("drone_pluck_spacing_beats", read.drone_pluck_spacing_beats)?,
+        );
+        set(
+            &mut settings.drone.cycle_pause_beats,
+            check.number("drone_cycle_pause_beats", read.drone_cycle_pause_beats)?,
+        );
+        set(
+            &mut settings.drone.humanize_timing_s,
+            check.number("drone_humanize_timing_s", read.drone_humanize_timing_s)?,
+        );
+        set(
+            &mut settings.drone.humanize_strength,
+            check.number("drone_humanize_strength", read.drone_humanize_strength)?,
+        );
+        if let Some(seed) = check.number("drone_humanize_seed", read.drone_humanize_seed)? {
+            // In range, so the conversion only drops a fraction.
+            settings.drone.humanize_seed = seed as u32;
+        }
         if let Some(instrument) = check.choice("instrument", read.instrument)? {
             settings.instrument = match instrument {
                 "bowed" => Instrument::Bowed,
@@ -485,15 +575,24 @@ impl Preset {
             gamma_per_s: value(v.gamma_per_s),
             eta_s: value(v.eta_s),
             nut_pickup_weight: value(v.nut_pickup_weight),
+            tanpura_output: text(TANPURA_OUTPUT_NAMES[s.tanpura_output as usize]),
             quality: text(v.quality.name()),
             pluck_position_m: value(s.pluck.position_m),
             pluck_width_m: value(s.pluck.width_m),
             pluck_amplitude_m: value(s.pluck.amplitude_m),
             output_gain_db: value(s.output_gain_db),
+            reference_a4_hz: value(s.tuning.a4_hz),
+            fine_tune_cents: value(s.tuning.fine_tune_cents),
             drone_enabled: Some(Spanned::new(0..0, s.drone.enabled)),
             drone_first_string: text(first_string_name(s.drone.first_string)),
+            drone_pattern: text(DRONE_PATTERN_NAMES[s.drone.pattern as usize]),
             drone_tempo_sync: Some(Spanned::new(0..0, s.drone.tempo_sync)),
             drone_tempo_bpm: value(s.drone.free_tempo_bpm),
+            drone_pluck_spacing_beats: value(s.drone.pluck_spacing_beats),
+            drone_cycle_pause_beats: value(s.drone.cycle_pause_beats),
+            drone_humanize_timing_s: value(s.drone.humanize_timing_s),
+            drone_humanize_strength: value(s.drone.humanize_strength),
+            drone_humanize_seed: value(f64::from(s.drone.humanize_seed)),
             instrument: text(INSTRUMENT_NAMES[s.instrument as usize]),
             bow_model: text(BOW_MODEL_NAMES[s.bowed.player.tier as usize]),
             bow_string: text(BOW_STRING_NAMES[s.bowed.string as usize]),
@@ -522,8 +621,14 @@ mod tests {
         preset.settings.voice.thread_enabled = false;
         preset.settings.pluck.width_m = 0.02;
         preset.settings.drone.enabled = true;
-        preset.settings.drone.first_string = FirstString::Ni;
+        preset.settings.drone.first_string = FirstString::KomalNi;
+        preset.settings.drone.pattern = DronePattern::Five;
+        preset.settings.drone.humanize_seed = 4_000_000_000;
+        preset.settings.drone.humanize_timing_s = 0.012;
+        preset.settings.tuning.a4_hz = 432.5;
+        preset.settings.tuning.fine_tune_cents = -23.0;
         preset.settings.voice.quality = Quality::Studio;
+        preset.settings.tanpura_output = TanpuraOutput::Radiated;
         preset.settings.instrument = Instrument::Bowed;
         preset.settings.bowed.string = BowedStringKind::CelloD;
         preset.settings.bowed.player.tier = BowTier::BowTable;

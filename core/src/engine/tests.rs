@@ -245,3 +245,87 @@ fn quality_change_keeps_ringing_strings_and_applies_from_the_next_pluck() {
         "the same string, now at the new tier"
     );
 }
+
+fn radiated() -> EngineSettings {
+    EngineSettings {
+        tanpura_output: TanpuraOutput::Radiated,
+        ..EngineSettings::default()
+    }
+}
+
+#[test]
+fn radiated_default_pluck_peaks_near_minus_12_dbfs() {
+    let mut engine = Engine::new(&radiated(), RATE, 1);
+    let output = run(&mut engine, &[note_on(0, 54)], 22_050);
+    let peak_dbfs = 20.0 * f64::from(peak(&output)).log10();
+    println!("radiated default pluck peak: {peak_dbfs:.2} dBFS");
+    assert!((-15.0..=-9.0).contains(&peak_dbfs), "{peak_dbfs} dBFS");
+}
+
+#[test]
+fn radiated_output_is_the_total_bridge_force_through_the_body() {
+    // Two strings ringing together: the body hears their summed bridge force.
+    let events = [note_on(0, 50), note_on(3_000, 57)];
+    let mut radiating = Engine::new(&radiated(), RATE, 2);
+    let heard = run(&mut radiating, &events, 11_025);
+    let mut bridge_settings = EngineSettings::default();
+    bridge_settings.voice.nut_pickup_weight = 0.0;
+    let mut bridge = Engine::new(&bridge_settings, RATE, 2);
+    let forces = run(&mut bridge, &events, 11_025);
+    let mut body = Body::new(&TANPURA_BODY, RATE);
+    let expected: Vec<f32> = forces
+        .iter()
+        .map(|force| body.tick(f64::from(*force)) as f32)
+        .collect();
+    assert_eq!(heard, expected);
+    assert!(peak(&heard) > 1e-3);
+    // And it is not the pickup signal.
+    let mut pickup = Engine::new(&EngineSettings::default(), RATE, 2);
+    assert_ne!(run(&mut pickup, &events, 11_025), heard);
+}
+
+#[test]
+fn six_string_drone_plucks_every_string_on_the_host_beat_to_the_sample() {
+    let mut settings = EngineSettings::default();
+    settings.drone.enabled = true;
+    settings.drone.pattern = drone::DronePattern::Six;
+    settings.drone.first_string = crate::tanpura::FirstString::Dha;
+    let mut engine = Engine::new(&settings, RATE, 8);
+    engine.set_host_tempo(Some(93.0)); // 28 451.6… samples per beat
+    let beat = 60.0 * RATE / 93.0;
+    run(&mut engine, &[note_on(0, 50)], (5.5 * beat) as usize);
+    let sa_hz = pitch::note_to_hz(50);
+    let ratios = [5.0 / 6.0, 5.0 / 6.0, 1.0, 1.0, 0.5, 0.5];
+    for (string, ratio) in ratios.iter().enumerate() {
+        let slot = engine
+            .slots
+            .iter()
+            .find(|slot| slot.key == Some(StringKey::Drone(string)))
+            .unwrap_or_else(|| panic!("string {string} not plucked"));
+        assert_eq!(slot.plucked_at, (string as f64 * beat).ceil() as u64);
+        assert_eq!(slot.fundamental_hz, sa_hz * ratio);
+    }
+    assert_eq!(engine.active_voices(), 6);
+}
+
+#[test]
+fn reference_pitch_and_fine_tuning_tune_notes_and_the_drone() {
+    let mut settings = EngineSettings {
+        tuning: pitch::Tuning {
+            a4_hz: 415.0,
+            fine_tune_cents: 25.0,
+        },
+        ..EngineSettings::default()
+    };
+    let expected = |note: u8| 415.0 * ((f64::from(note) - 69.0) / 12.0 + 25.0 / 1200.0).exp2();
+    let mut engine = Engine::new(&settings, RATE, 2);
+    run(&mut engine, &[note_on(0, 57)], 64);
+    let played = engine.slots.iter().find(|slot| slot.key.is_some()).unwrap();
+    assert!((played.fundamental_hz / expected(57) - 1.0).abs() < 1e-12);
+
+    settings.drone.enabled = true;
+    let mut drone = Engine::new(&settings, RATE, 4);
+    run(&mut drone, &[note_on(0, 50)], 64);
+    let first = drone.slots.iter().find(|slot| slot.key.is_some()).unwrap();
+    assert!((first.fundamental_hz / (0.75 * expected(50)) - 1.0).abs() < 1e-12);
+}

@@ -1,4 +1,4 @@
-//! The four-string drone instrument: first string (Pa, Ma or Ni), Sa, Sa, low Sa, each a
+//! The four-string drone instrument: first string (Pa, Ma, Ni, komal Ni or Dha), Sa, Sa, low Sa, each a
 //! [`TanpuraVoice`].
 
 use super::excitation::Pluck;
@@ -12,17 +12,32 @@ pub enum FirstString {
     Pa,
     /// The fourth: 2/3 of Sa (Ma of the lower octave).
     Ma,
-    /// The major seventh: 15/16 of Sa (Ni of the lower octave).
+    /// The major seventh, shuddha Ni: 15/16 of Sa (15/8 an octave lower).
     Ni,
+    /// The minor seventh, komal Ni: 8/9 of Sa (16/9, two just fourths, an octave lower).
+    KomalNi,
+    /// The major sixth, Dha: 5/6 of Sa (5/3 an octave lower).
+    Dha,
 }
 
 impl FirstString {
-    /// Frequency ratio to Sa.
+    /// Every first string, in the order the plugin and presets list them.
+    pub const ALL: [FirstString; 5] = [
+        FirstString::Pa,
+        FirstString::Ma,
+        FirstString::Ni,
+        FirstString::KomalNi,
+        FirstString::Dha,
+    ];
+
+    /// Frequency ratio to Sa: just intonation, the lower octave.
     pub fn ratio(self) -> f64 {
         match self {
             FirstString::Pa => 3.0 / 4.0,
             FirstString::Ma => 2.0 / 3.0,
             FirstString::Ni => 15.0 / 16.0,
+            FirstString::KomalNi => 8.0 / 9.0,
+            FirstString::Dha => 5.0 / 6.0,
         }
     }
 }

@@ -105,11 +105,27 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
             row(ui, setter, &params.drone_enabled,
                 "Drone mode: a held MIDI note sets Sa, and four strings (first string, Sa, Sa, low Sa) are plucked in the classic cycle.");
             row(ui, setter, &params.drone_first_string,
-                "Tuning of the first drone string: Pa = 3/4 of Sa (the fifth below), Ma = 2/3 (the fourth below), Ni = 15/16 (the major seventh below).");
+                "Tuning of the first drone string, in just intonation below Sa: Pa = 3/4 (the fifth), Ma = 2/3 (the fourth), Ni = 15/16 (major seventh), komal Ni = 8/9 (minor seventh), Dha = 5/6 (major sixth).");
             row(ui, setter, &params.drone_tempo_sync,
                 "On: the drone cycle follows the host's tempo. Off: it uses the drone tempo below.");
             row(ui, setter, &params.drone_tempo_bpm,
-                "Tempo of the drone cycle when not synced to the host, plucks per minute.");
+                "Tempo of the drone cycle when not synced to the host, beats per minute.");
+            row(ui, setter, &params.reference_a4_hz,
+                "The pitch of A4 every note is tuned from (440 Hz; 415 to 466 Hz for other concert pitches).");
+            row(ui, setter, &params.fine_tune_cents,
+                "Moves every note, and so the drone's Sa, by up to a semitone: tune the drone to a voice or an instrument between two keys.");
+            row(ui, setter, &params.drone_pattern,
+                "How many strings: 4 (first, Sa, Sa, low Sa), 5 (first, Ni, Sa, Sa, low Sa) or 6 (first, first, Sa, Sa, low Sa, low Sa).");
+            row(ui, setter, &params.drone_spacing_beats,
+                "Beats between two plucks of the cycle.");
+            row(ui, setter, &params.drone_pause_beats,
+                "Extra beats after the last string before the cycle starts again (the classic cycle: spacing 1, pause 1).");
+            row(ui, setter, &params.drone_humanize_ms,
+                "Each pluck comes up to this much early or late, as a player's would (0: exactly on the beat).");
+            row(ui, setter, &params.drone_humanize_percent,
+                "Each pluck is up to this much softer than the full pluck.");
+            row(ui, setter, &params.drone_seed,
+                "The humanisation's random sequence: the same seed always plays the same way.");
         });
         group(ui, "Jawari: thread and bridge", |ui| {
             row(ui, setter, &params.thread_enabled,
@@ -161,8 +177,10 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
                 "How the string is simulated. Draft and Live: the string's exact modes at the output rate with contact on a few points (fast, no latency). Studio and Reference: the seed's finite-difference grid at 2x and 4x oversampling (more accurate to the paper, far more CPU; watch the load meter above).");
         });
         group(ui, "Output", |ui| {
+            row(ui, setter, &params.tanpura_output,
+                "Radiated: the tanpura as a listener hears it, the strings' total force on the bridge through the body's resonances (fitted to the response van Walstijn, Bridges and Mehes measured on a tanpura, DAFx-16). Pickup: the raw string forces chosen below.");
             row(ui, setter, &params.nut_pickup_percent,
-                "What you hear: 100 % is the force the string exerts on the nut (eq. 13), 0 % the force on bridge and thread (eq. 12), in between a mix.");
+                "With output Pickup: 100 % is the force the string exerts on the nut (eq. 13, the seed's signal), 0 % the force on bridge and thread (eq. 12), in between a mix.");
             row(ui, setter, &params.output_gain_db,
                 "Output level. At 0 dB a pickup force of 2 N is digital full scale.");
         });

@@ -1,9 +1,11 @@
-//! The three loops over the modes, as SIMD kernels dispatched at run time.
+//! The loops over the modes, as SIMD kernels dispatched at run time.
 //!
-//! The modal step (`docs/modal-tanpura.md`, eq. M1) spends its time in three passes over the
-//! contiguous mode arrays: the free step `s = a p − b r`, the free motion of the contact points near
-//! contact `Δu_i = Ψ_i · s` (one dot product per point), and the update that adds the contact forces,
-//! advances the state and forms the nut force. Each pass is a [`pulp::WithSimd`] kernel:
+//! The modal step (`docs/modal-tanpura.md`, eq. M1) spends its time in two passes over the
+//! contiguous mode arrays: the free motion of the contact points near contact `Δu_i = Ψ_i · s`
+//! (one dot product per point), and the update that adds the contact forces, advances the state,
+//! forms the nut force and computes the next step's free step `s = a p − b r` and its norm in the
+//! same pass, so that a step stores only r, p and s. (The free step alone, [`Kernels::free_step`],
+//! is needed only after the state is set from outside.) Each pass is a [`pulp::WithSimd`] kernel:
 //! [`pulp::Arch`] picks AVX-512, AVX2+FMA or scalar code once per process from the CPU, so the one
 //! generic x86-64 binary runs the widest unit the machine has (pulp comes with faer, so it adds
 //! nothing to the build). The kernels are generic over [`Real`] (f32 for the fast tier, f64 for
@@ -227,62 +229,101 @@ impl<T: Real> WithSimd for Dots<'_, T> {
     }
 }
 
-/// Adds the contact forces to the free step and advances the state (eq. M1):
-/// `s += b Σ_j ΔF_j Ψ_j`, `r += s`, `p = s − p`; returns the nut force `c · r` after the step.
-struct Advance<'a, T: Real> {
+/// Rows of Ψ whose forces the fused update keeps in registers; further rows go through memory.
+const REGISTER_ROWS: usize = 8;
+
+/// Adds the contact forces to the free step, advances the state (eq. M1) and prepares the next
+/// step, in one pass over the modes: `s += b Σ_j ΔF_j Ψ_j`, `r += s`, `p = s − p`, then the next
+/// free step `s ← a p − b r`. Returns the nut force `c · r` after the step and `‖s_next‖²`. The
+/// modal force of the first [`REGISTER_ROWS`] rows never leaves the registers, so a pass stores
+/// only r, p and the next free step (and the whole step when `whole_step` is given).
+struct AdvanceAndPrepare<'a, T: Real> {
+    a: &'a [T],
     b: &'a [T],
     c: &'a [T],
     matrix: &'a [T],
     stride: usize,
     rows: &'a [usize],
     forces: &'a [T],
-    modal_force: &'a mut [T],
+    /// Scratch of the arrays' length for the rows beyond [`REGISTER_ROWS`].
+    overflow: &'a mut [T],
     s: &'a mut [T],
     r: &'a mut [T],
     p: &'a mut [T],
+    whole_step: Option<&'a mut [T]>,
 }
 
-impl<T: Real> WithSimd for Advance<'_, T> {
-    type Output = f64;
+impl<T: Real> WithSimd for AdvanceAndPrepare<'_, T> {
+    type Output = (f64, f64);
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> f64 {
+    fn with_simd<S: Simd>(self, simd: S) -> (f64, f64) {
         let zero = T::splat(simd, T::default());
         let length = self.s.len();
-        // Σ_j ΔF_j Ψ_j, one contiguous row at a time.
-        let modal_force = T::lanes_mut::<S>(self.modal_force);
-        modal_force.fill(zero);
-        for (&row, force) in self.rows.iter().zip(self.forces) {
-            let force = T::splat(simd, *force);
+        let shape = |row: usize| {
             let start = row * self.stride;
-            let shape = T::lanes::<S>(&self.matrix[start..start + length]);
-            for (sum, shape) in modal_force.iter_mut().zip(shape) {
-                *sum = T::mul_add(simd, *shape, force, *sum);
+            T::lanes::<S>(&self.matrix[start..start + length])
+        };
+        let head = self.rows.len().min(REGISTER_ROWS);
+        let mut head_rows: [&[T::Lanes<S>]; REGISTER_ROWS] = [&[]; REGISTER_ROWS];
+        let mut head_forces = [zero; REGISTER_ROWS];
+        for j in 0..head {
+            head_rows[j] = shape(self.rows[j]);
+            head_forces[j] = T::splat(simd, self.forces[j]);
+        }
+        let overflow = T::lanes_mut::<S>(self.overflow);
+        let spills = self.rows.len() > REGISTER_ROWS;
+        if spills {
+            overflow.fill(zero);
+            for (&row, force) in self.rows[REGISTER_ROWS..]
+                .iter()
+                .zip(&self.forces[REGISTER_ROWS..])
+            {
+                let force = T::splat(simd, *force);
+                for (sum, shape) in overflow.iter_mut().zip(shape(row)) {
+                    *sum = T::mul_add(simd, *shape, force, *sum);
+                }
             }
         }
-        let b = T::lanes::<S>(self.b);
-        let c = T::lanes::<S>(self.c);
+        let (a, b, c) = (
+            T::lanes::<S>(self.a),
+            T::lanes::<S>(self.b),
+            T::lanes::<S>(self.c),
+        );
         let s = T::lanes_mut::<S>(self.s);
         let r = T::lanes_mut::<S>(self.r);
         let p = T::lanes_mut::<S>(self.p);
-        // The nut force over two accumulators (the arrays are whole register pairs).
+        let mut whole_step = self.whole_step.map(|w| T::lanes_mut::<S>(w));
+        // Two accumulators each for the nut force and the norm (the arrays are register pairs).
         let mut nut = [zero; 2];
-        let modes = s
-            .chunks_exact_mut(2)
-            .zip(r.chunks_exact_mut(2))
-            .zip(p.chunks_exact_mut(2))
-            .zip(b.chunks_exact(2).zip(c.chunks_exact(2)))
-            .zip(modal_force.chunks_exact(2));
-        for ((((s, r), p), (b, c)), force) in modes {
-            for j in 0..2 {
-                let step = T::mul_add(simd, b[j], force[j], s[j]);
-                s[j] = step;
-                r[j] = T::add(simd, r[j], step);
-                p[j] = T::sub(simd, step, p[j]);
-                nut[j] = T::mul_add(simd, c[j], r[j], nut[j]);
+        let mut norm = [zero; 2];
+        for v in 0..s.len() {
+            let mut force = if spills { overflow[v] } else { zero };
+            for j in 0..head {
+                force = T::mul_add(simd, head_rows[j][v], head_forces[j], force);
             }
+            let step = T::mul_add(simd, b[v], force, s[v]);
+            if let Some(whole_step) = whole_step.as_deref_mut() {
+                whole_step[v] = step;
+            }
+            let displacement = T::add(simd, r[v], step);
+            let velocity = T::sub(simd, step, p[v]);
+            r[v] = displacement;
+            p[v] = velocity;
+            let lane = v % 2;
+            nut[lane] = T::mul_add(simd, c[v], displacement, nut[lane]);
+            let next = T::sub(
+                simd,
+                T::mul(simd, a[v], velocity),
+                T::mul(simd, b[v], displacement),
+            );
+            s[v] = next;
+            norm[lane] = T::mul_add(simd, next, next, norm[lane]);
         }
-        T::sum(simd, T::add(simd, nut[0], nut[1])).to_f64()
+        (
+            T::sum(simd, T::add(simd, nut[0], nut[1])).to_f64(),
+            T::sum(simd, T::add(simd, norm[0], norm[1])).to_f64(),
+        )
     }
 }
 
@@ -312,33 +353,39 @@ impl Kernels {
         });
     }
 
-    /// `s += b Σ_j forces_j matrix[rows_j]`, `r += s`, `p = s − p`; returns `c · r`.
-    /// `modal_force` is scratch of the arrays' length.
+    /// `s += b Σ_j forces_j matrix[rows_j]`, `r += s`, `p = s − p` (the whole step into
+    /// `whole_step` if given), then the next free step `s ← a p − b r`; returns `(c · r, ‖s‖²)`
+    /// after the step. `overflow` is scratch of the arrays' length.
     #[allow(clippy::too_many_arguments)]
-    pub fn advance<T: Real>(
+    pub fn advance_and_prepare<T: Real>(
         &self,
+        a: &[T],
         b: &[T],
         c: &[T],
         matrix: &[T],
         stride: usize,
         rows: &[usize],
         forces: &[T],
-        modal_force: &mut [T],
+        overflow: &mut [T],
         s: &mut [T],
         r: &mut [T],
         p: &mut [T],
-    ) -> f64 {
-        self.arch.dispatch(Advance {
+        whole_step: Option<&mut [T]>,
+    ) -> (f64, f64) {
+        debug_assert!(forces.len() >= rows.len());
+        self.arch.dispatch(AdvanceAndPrepare {
+            a,
             b,
             c,
             matrix,
             stride,
             rows,
             forces,
-            modal_force,
+            overflow,
             s,
             r,
             p,
+            whole_step,
         })
     }
 }
@@ -375,31 +422,41 @@ mod tests {
             assert!((dots[j] - plain).abs() < 1e-13, "row {j}");
         }
 
-        let forces = [0.3, -1.2, 0.05];
-        let (mut s2, mut r2, mut p2) = (s.clone(), r.clone(), p.clone());
-        let mut scratch = vec![0.0; n];
-        let nut = kernels.advance(
-            &b,
-            &c,
-            &matrix,
-            n,
-            &[0, 1, 2],
-            &forces,
-            &mut scratch,
-            &mut s2,
-            &mut r2,
-            &mut p2,
-        );
-        let mut plain_nut = 0.0;
-        for k in 0..n {
-            let modal: f64 = (0..3).map(|j| forces[j] * rows[j][k]).sum();
-            let step = s[k] + b[k] * modal;
-            assert!((s2[k] - step).abs() < 1e-14);
-            assert!((r2[k] - (r[k] + step)).abs() < 1e-14);
-            assert!((p2[k] - (step - p[k])).abs() < 1e-14);
-            plain_nut += c[k] * (r[k] + step);
+        // Three rows stay in registers; eleven spill the last three through memory.
+        for count in [3, 11] {
+            let forces: Vec<f64> = (0..count).map(|j| 0.3 - 0.17 * j as f64).collect();
+            let (mut s2, mut r2, mut p2) = (s.clone(), r.clone(), p.clone());
+            let (mut scratch, mut whole) = (vec![0.0; n], vec![0.0; n]);
+            let (nut, norm) = kernels.advance_and_prepare(
+                &a,
+                &b,
+                &c,
+                &matrix,
+                n,
+                &all[..count],
+                &forces,
+                &mut scratch,
+                &mut s2,
+                &mut r2,
+                &mut p2,
+                Some(&mut whole),
+            );
+            let (mut plain_nut, mut plain_norm) = (0.0, 0.0);
+            for k in 0..n {
+                let modal: f64 = (0..count).map(|j| forces[j] * rows[j][k]).sum();
+                let step = s[k] + b[k] * modal;
+                let (displacement, velocity) = (r[k] + step, step - p[k]);
+                let next = a[k] * velocity - b[k] * displacement;
+                assert!((whole[k] - step).abs() < 1e-13);
+                assert!((r2[k] - displacement).abs() < 1e-13);
+                assert!((p2[k] - velocity).abs() < 1e-13);
+                assert!((s2[k] - next).abs() < 1e-13);
+                plain_nut += c[k] * displacement;
+                plain_norm += next * next;
+            }
+            assert!((nut - plain_nut).abs() < 1e-12, "{count} rows");
+            assert!((norm - plain_norm).abs() < 1e-12, "{count} rows");
         }
-        assert!((nut - plain_nut).abs() < 1e-13);
     }
 
     #[test]

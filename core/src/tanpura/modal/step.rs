@@ -1,0 +1,581 @@
+//! The contact solve of one modal step (`docs/modal-tanpura.md`, section 4).
+//!
+//! With `Δu_free = Ψ s_free` and the coupling `G`, the points' step solves
+//! `R(Δu) = Δu − Δu_free − G (F(Δu) − F_rest) = 0`, where F is the seed's mid-point force of
+//! every point (eq. 4, `contact.rs`). Newton's Jacobian is `J = I + G C`, `C = diag(−∂F/∂Δu)`.
+//! On the points A with `c_i > 0` the update solves `(I + D G_AA D) y = −D R_A`, `D = diag(√c_i)`,
+//! then `δ = −R − G_{:,A} D y` for every point: the exact `δ = −J⁻¹ R`, through a symmetric
+//! positive definite matrix whose eigenvalues are at least 1 (never ill-conditioned, however
+//! close the points or stiff the contact). Residual and Jacobian are those of the full step, so
+//! the accepted Δu satisfies the scheme to the tolerance and the energy balance (eq. M3) holds.
+//! Stops when `max|δ| ≤ tolerance`, or exactly when an update leaves every point in the contact
+//! case it had (the law is linear there); at the cap the last iterate is taken and counted.
+//!
+//! **Which points Newton sees.** Only the *tracked* points, those within the tracking band of
+//! contact or loaded at rest, take part; their state lives in compact arrays in slot order, with
+//! their block of G, so a step touches no index list and no other point. Every other (far) point
+//! carries an upper bound on its gap, raised each step by the most it can move,
+//! `‖Ψ_i‖ ‖s_free‖ + |Σ_j G_ij ΔF_j|` (Cauchy–Schwarz); one pass over all points, in plain
+//! arrays the compiler vectorises, forms these bounds, and only a point whose bound reaches
+//! contact is evaluated exactly. If it would touch during the step it joins and the solve is
+//! redone before anything moves, so the solve is exact for every point.
+//!
+//! Hand-written rather than on a linear-algebra crate: the systems are 1–12 points, solved once
+//! or twice per sample on the audio thread; the fixed-size LDLᵀ of `solve.rs` is unrolled by the
+//! compiler, and nothing here allocates.
+
+use super::points::ContactPoints;
+use super::solve::{ldl_solve_fixed, ldl_solve_in_place};
+use crate::newton::NewtonSettings;
+use crate::tanpura::contact::HuntCrossley;
+
+/// The slot of a point that is not tracked.
+const UNTRACKED: usize = usize::MAX;
+
+/// Per-step state of the contact points; allocation-free after `new`.
+#[derive(Debug, Clone)]
+pub struct ContactStep {
+    capacity: usize,
+    /// a_i per point, m: exact for the tracked points (after every step), the last exact value
+    /// for the far ones.
+    pub gaps_m: Vec<f64>,
+    /// An upper bound on a_i for a far point, m; −∞ for a tracked point, so that no test on far
+    /// points ever selects it.
+    far_bounds_m: Vec<f64>,
+    /// This step's `Σ_j G_ij ΔF_j` and raised bound, per point.
+    coupled_m: Vec<f64>,
+    next_bounds_m: Vec<f64>,
+    /// Far points to evaluate exactly, and their exact gaps and free steps.
+    candidates: Vec<usize>,
+    candidate_gaps_m: Vec<f64>,
+    candidate_free_steps_m: Vec<f64>,
+    /// Each point's slot among the tracked, or [`UNTRACKED`].
+    slots: Vec<usize>,
+    /// The tracked points (point indices), in slot order.
+    tracked: Vec<usize>,
+    count: usize,
+    // Per slot: the gap before the step, the free step Ψ_i s_free, the iterate Δu_i, the last
+    // accepted Δu − Δu_free (the next step's initial guess), the rest force and the law.
+    gaps: Vec<f64>,
+    free_steps: Vec<f64>,
+    steps: Vec<f64>,
+    corrections: Vec<f64>,
+    rest_forces: Vec<f64>,
+    laws: Vec<HuntCrossley>,
+    /// F, c = −∂F/∂Δu and F − F_rest at the last evaluation.
+    forces: Vec<f64>,
+    stiffnesses: Vec<f64>,
+    changes: Vec<f64>,
+    /// Slots with F ≠ F_rest at the last evaluation.
+    loaded: Vec<usize>,
+    loaded_count: usize,
+    /// G on the tracked points, `capacity × capacity` with row stride `capacity`.
+    block: Vec<f64>,
+    residual: Vec<f64>,
+    /// The slots with c > 0 at the last evaluation and their √c.
+    active: Vec<usize>,
+    roots: Vec<f64>,
+    matrix: Vec<f64>,
+    solution: Vec<f64>,
+    scratch: Vec<f64>,
+    /// The loaded points as point indices and their F − F_rest, N: what the modes feel.
+    loaded_points: Vec<usize>,
+    loaded_changes_n: Vec<f64>,
+}
+
+/// Whether a point is in contact before and after a step `step` from gap `gap`.
+#[inline]
+fn contact_case(gap: f64, step: f64) -> (bool, bool) {
+    (gap > 0.0, gap - step > 0.0)
+}
+
+impl ContactStep {
+    /// Room for `capacity` points. Allocates.
+    pub fn new(capacity: usize) -> Self {
+        let zeros = || vec![0.0; capacity];
+        Self {
+            capacity,
+            gaps_m: zeros(),
+            far_bounds_m: zeros(),
+            coupled_m: zeros(),
+            next_bounds_m: zeros(),
+            candidates: vec![0; capacity],
+            candidate_gaps_m: zeros(),
+            candidate_free_steps_m: zeros(),
+            slots: vec![UNTRACKED; capacity],
+            tracked: vec![0; capacity],
+            count: 0,
+            gaps: zeros(),
+            free_steps: zeros(),
+            steps: zeros(),
+            corrections: zeros(),
+            rest_forces: zeros(),
+            laws: vec![HuntCrossley { xi: 0.0, psi: 0.0 }; capacity],
+            forces: zeros(),
+            stiffnesses: zeros(),
+            changes: zeros(),
+            loaded: vec![0; capacity],
+            loaded_count: 0,
+            block: vec![0.0; capacity * capacity],
+            residual: zeros(),
+            active: vec![0; capacity],
+            roots: zeros(),
+            matrix: vec![0.0; capacity * capacity],
+            solution: zeros(),
+            scratch: zeros(),
+            loaded_points: vec![0; capacity],
+            loaded_changes_n: zeros(),
+        }
+    }
+
+    /// The tracked points in slot order, and where their free steps `Ψ_i s_free` go.
+    pub fn tracked_rows(&mut self) -> (&[usize], &mut [f64]) {
+        (
+            &self.tracked[..self.count],
+            &mut self.free_steps[..self.count],
+        )
+    }
+
+    pub fn tracked_count(&self) -> usize {
+        self.count
+    }
+
+    /// The points with F ≠ F_rest after the last solve and their F − F_rest, N.
+    pub fn loaded(&self) -> (&[usize], &[f64]) {
+        (
+            &self.loaded_points[..self.loaded_count],
+            &self.loaded_changes_n[..self.loaded_count],
+        )
+    }
+
+    /// Tracks the points whose gap lies within `band_m` of contact or that carry a force at rest,
+    /// from scratch. Every gap in `gaps_m` must be exact on entry. Forgets the initial guesses.
+    pub fn classify(&mut self, points: &ContactPoints, band_m: f64) {
+        for slot in 0..self.count {
+            self.slots[self.tracked[slot]] = UNTRACKED;
+        }
+        self.count = 0;
+        for i in 0..points.len() {
+            self.far_bounds_m[i] = self.gaps_m[i];
+            if self.gaps_m[i] > -band_m || points.rest_forces_n[i] != 0.0 {
+                self.track(points, i, self.gaps_m[i], 0.0, 0.0);
+            }
+        }
+        self.loaded_count = 0;
+    }
+
+    /// Forgets Newton's initial guesses (a new excitation starts as on a fresh string).
+    pub fn forget_corrections(&mut self) {
+        self.corrections[..self.count].fill(0.0);
+    }
+
+    /// Starts tracking point i with gap `gap`, free step `free_step` and initial correction
+    /// `correction`: a new slot at the end, and its row and column of the block.
+    fn track(
+        &mut self,
+        points: &ContactPoints,
+        i: usize,
+        gap: f64,
+        free_step: f64,
+        correction: f64,
+    ) {
+        let slot = self.count;
+        self.count += 1;
+        self.slots[i] = slot;
+        self.tracked[slot] = i;
+        self.far_bounds_m[i] = f64::NEG_INFINITY;
+        self.gaps[slot] = gap;
+        self.free_steps[slot] = free_step;
+        self.steps[slot] = free_step + correction;
+        self.corrections[slot] = correction;
+        self.rest_forces[slot] = points.rest_forces_n[i];
+        self.laws[slot] = points.laws[i];
+        self.forces[slot] = points.rest_forces_n[i];
+        let stride = self.capacity;
+        for other in 0..=slot {
+            let value = points.coupling(i, self.tracked[other]);
+            self.block[slot * stride + other] = value;
+            self.block[other * stride + slot] = value;
+        }
+    }
+
+    /// Stops tracking the point in `slot`: the last slot moves into it.
+    fn untrack(&mut self, slot: usize) {
+        let i = self.tracked[slot];
+        self.slots[i] = UNTRACKED;
+        self.far_bounds_m[i] = self.gaps[slot];
+        self.corrections[slot] = 0.0;
+        let last = self.count - 1;
+        self.count = last;
+        if slot == last {
+            return;
+        }
+        let moved = self.tracked[last];
+        self.tracked[slot] = moved;
+        self.slots[moved] = slot;
+        self.gaps[slot] = self.gaps[last];
+        self.free_steps[slot] = self.free_steps[last];
+        self.steps[slot] = self.steps[last];
+        self.corrections[slot] = self.corrections[last];
+        self.rest_forces[slot] = self.rest_forces[last];
+        self.laws[slot] = self.laws[last];
+        self.forces[slot] = self.forces[last];
+        let stride = self.capacity;
+        for other in 0..last {
+            let value = self.block[last * stride + other];
+            self.block[slot * stride + other] = value;
+            self.block[other * stride + slot] = value;
+        }
+        self.block[slot * stride + slot] = self.block[last * stride + last];
+    }
+
+    /// Solves the step's contact (the free steps of the tracked points must be in place). Far
+    /// points whose bounds reach contact are evaluated together by
+    /// `refresh(points, gaps, free_steps)`, which writes each listed point's `a_i` and
+    /// `Ψ_i s_free`; one that would touch joins and the solve is redone. Returns (Newton
+    /// updates, converged).
+    pub fn solve(
+        &mut self,
+        points: &ContactPoints,
+        shape_norms: &[f64],
+        step_norm: f64,
+        settings: &NewtonSettings,
+        mut refresh: impl FnMut(&[usize], &mut [f64], &mut [f64]),
+    ) -> (u32, bool) {
+        for slot in 0..self.count {
+            self.steps[slot] = self.free_steps[slot] + self.corrections[slot];
+        }
+        let mut iterations = 0;
+        let mut converged = true;
+        loop {
+            if !self.settle_if_free() {
+                let (updates, done) = self.newton(settings);
+                iterations += updates;
+                converged = done;
+                // The forces at the accepted step, for the update, the outputs and the ledger.
+                self.evaluate();
+            }
+            if !self.check_far_points(points, shape_norms, step_norm, &mut refresh) {
+                break;
+            }
+        }
+        for (slot, &local) in self.loaded[..self.loaded_count].iter().enumerate() {
+            self.loaded_points[slot] = self.tracked[local];
+            self.loaded_changes_n[slot] = self.changes[local];
+        }
+        (iterations, converged)
+    }
+
+    /// Raises every far point's gap bound by the most it can move this step; a point whose bound
+    /// reaches contact is evaluated exactly, and one that would touch joins (returns true: the
+    /// solve must be redone).
+    fn check_far_points(
+        &mut self,
+        points: &ContactPoints,
+        shape_norms: &[f64],
+        step_norm: f64,
+        refresh: &mut impl FnMut(&[usize], &mut [f64], &mut [f64]),
+    ) -> bool {
+        let count = points.len();
+        let stride = self.capacity;
+        // Σ_j G_ij ΔF_j for every point, a row of G (= its column) per loaded point.
+        let coupled = &mut self.coupled_m[..count];
+        coupled.fill(0.0);
+        for &local in &self.loaded[..self.loaded_count] {
+            let row = self.tracked[local] * stride;
+            let change = self.changes[local];
+            for (sum, g) in coupled.iter_mut().zip(&points.coupling[row..row + count]) {
+                *sum += g * change;
+            }
+        }
+        let mut reaches_contact = false;
+        let bounds = self.far_bounds_m[..count]
+            .iter()
+            .zip(&shape_norms[..count])
+            .zip(coupled.iter());
+        for (next, ((&bound, &norm), &coupled)) in
+            self.next_bounds_m[..count].iter_mut().zip(bounds)
+        {
+            *next = bound + (norm * step_norm + coupled.abs());
+            reaches_contact |= *next > 0.0;
+        }
+        if !reaches_contact {
+            return false;
+        }
+        // Branch-free selection: every point is written, the count advances on the selected.
+        let mut listed = 0;
+        for (i, &bound) in self.next_bounds_m[..count].iter().enumerate() {
+            self.candidates[listed] = i;
+            listed += usize::from(bound > 0.0);
+        }
+        refresh(
+            &self.candidates[..listed],
+            &mut self.candidate_gaps_m[..listed],
+            &mut self.candidate_free_steps_m[..listed],
+        );
+        let mut joined = false;
+        for candidate in 0..listed {
+            let i = self.candidates[candidate];
+            let gap = self.candidate_gaps_m[candidate];
+            let free_step = self.candidate_free_steps_m[candidate];
+            let coupled = self.coupled_m[i];
+            let step = free_step + coupled;
+            self.gaps_m[i] = gap;
+            if gap - step > 0.0 {
+                self.track(points, i, gap, free_step, coupled);
+                joined = true;
+            } else {
+                self.far_bounds_m[i] = gap;
+                self.next_bounds_m[i] = gap - step;
+            }
+        }
+        joined
+    }
+
+    /// After the solve: moves the tracked gaps by the accepted steps, keeps the corrections for
+    /// the next guess and the far bounds for the next step. Returns the deepest penetration of
+    /// the tracked points after the step (0 if none), m.
+    pub fn finish_step(&mut self, points: &ContactPoints) -> f64 {
+        let count = points.len();
+        self.far_bounds_m[..count].copy_from_slice(&self.next_bounds_m[..count]);
+        let mut penetration = 0.0f64;
+        for slot in 0..self.count {
+            let gap = self.gaps[slot] - self.steps[slot];
+            self.gaps[slot] = gap;
+            self.gaps_m[self.tracked[slot]] = gap;
+            self.corrections[slot] = self.steps[slot] - self.free_steps[slot];
+            penetration = penetration.max(gap);
+        }
+        penetration
+    }
+
+    /// After a step: tracked points farther than `release_m` from contact with no force now and
+    /// none at rest leave; far points whose bound comes within `band_m` of contact get their
+    /// exact gaps, all at once from `exact_gaps(points, gaps)`, and join if within the band.
+    pub fn update_tracking(
+        &mut self,
+        points: &ContactPoints,
+        band_m: f64,
+        release_m: f64,
+        mut exact_gaps: impl FnMut(&[usize], &mut [f64]),
+    ) {
+        let mut slot = 0;
+        while slot < self.count {
+            let far = self.gaps[slot] < -release_m
+                && self.forces[slot] == 0.0
+                && self.rest_forces[slot] == 0.0;
+            if far {
+                self.untrack(slot);
+            } else {
+                slot += 1;
+            }
+        }
+        // Branch-free selection, as in `check_far_points`; tracked points have a bound of −∞.
+        let mut listed = 0;
+        for (i, &bound) in self.far_bounds_m[..points.len()].iter().enumerate() {
+            self.candidates[listed] = i;
+            listed += usize::from(bound > -band_m);
+        }
+        if listed == 0 {
+            return;
+        }
+        exact_gaps(
+            &self.candidates[..listed],
+            &mut self.candidate_gaps_m[..listed],
+        );
+        for candidate in 0..listed {
+            let i = self.candidates[candidate];
+            let gap = self.candidate_gaps_m[candidate];
+            self.gaps_m[i] = gap;
+            self.far_bounds_m[i] = gap;
+            if gap > -band_m {
+                self.track(points, i, gap, 0.0, 0.0);
+            }
+        }
+    }
+
+    /// Evaluates every tracked point's force at the iterate and lists the slots whose force
+    /// differs from its rest value.
+    fn evaluate(&mut self) {
+        let count = self.count;
+        self.loaded_count = 0;
+        for slot in 0..count {
+            let contact =
+                self.laws[slot].midpoint_force_linear_damping(self.gaps[slot], self.steps[slot]);
+            self.forces[slot] = contact.force;
+            self.stiffnesses[slot] = contact.stiffness;
+            let change = contact.force - self.rest_forces[slot];
+            self.changes[slot] = change;
+            if change != 0.0 {
+                self.loaded[self.loaded_count] = slot;
+                self.loaded_count += 1;
+            }
+        }
+    }
+
+    /// Whether no point can exert a force different from its rest force during the free step:
+    /// nothing rests in contact and nothing touches before or after. Then the free step is the
+    /// exact solution and the forces are zero.
+    fn settle_if_free(&mut self) -> bool {
+        let count = self.count;
+        let free = self.rest_forces[..count]
+            .iter()
+            .zip(&self.gaps[..count])
+            .zip(&self.free_steps[..count])
+            .all(|((&rest, &gap), &free)| rest == 0.0 && gap <= 0.0 && gap - free <= 0.0);
+        if free {
+            self.loaded_count = 0;
+            self.steps[..count].copy_from_slice(&self.free_steps[..count]);
+            self.forces[..count].fill(0.0);
+            self.changes[..count].fill(0.0);
+        }
+        free
+    }
+
+    /// Newton's iteration from the current steps: at most `settings.max_iterations` updates.
+    fn newton(&mut self, settings: &NewtonSettings) -> (u32, bool) {
+        let cap = settings.max_iterations.max(1);
+        for iteration in 1..=cap {
+            self.evaluate();
+            let linear = self.cases_unchanged();
+            let largest = self.update();
+            if !largest.is_finite() {
+                return (iteration, false);
+            }
+            // Linear at the evaluation point and still in the same cases after the update: the
+            // law was linear all the way, so the update solved the step exactly.
+            if largest <= settings.tolerance_m || (linear && self.cases_unchanged()) {
+                return (iteration, true);
+            }
+        }
+        (cap, false)
+    }
+
+    /// Whether every tracked point is in the same contact case before and after its step.
+    fn cases_unchanged(&self) -> bool {
+        self.gaps[..self.count]
+            .iter()
+            .zip(&self.steps[..self.count])
+            .all(|(&gap, &step)| {
+                let (before, after) = contact_case(gap, step);
+                before == after
+            })
+    }
+
+    /// One Newton update `δ = −J⁻¹ R` at the last evaluation; applies it and returns its largest
+    /// component (NaN when the state is not finite). The residual needs G only on the loaded
+    /// points' rows, the linear solve only on the points with `c > 0` (the others' rows of
+    /// `I + D G D` are identity rows).
+    fn update(&mut self) -> f64 {
+        let count = self.count;
+        let stride = self.capacity;
+        // R = Δu − Δu_free − G ΔF, with ΔF ≠ 0 only on the loaded points (G is symmetric, so
+        // each loaded point adds its row).
+        let residual = &mut self.residual[..count];
+        for ((r, &step), &free) in residual
+            .iter_mut()
+            .zip(&self.steps[..count])
+            .zip(&self.free_steps[..count])
+        {
+            *r = step - free;
+        }
+        for &u in &self.loaded[..self.loaded_count] {
+            let change = self.changes[u];
+            let row = &self.block[u * stride..u * stride + count];
+            for (r, g) in residual.iter_mut().zip(row) {
+                *r -= g * change;
+            }
+        }
+        // A: the points with c > 0, and D = diag(√c) on them.
+        let mut size = 0;
+        for slot in 0..count {
+            if self.stiffnesses[slot] > 0.0 {
+                self.active[size] = slot;
+                self.roots[size] = self.stiffnesses[slot].sqrt();
+                size += 1;
+            }
+        }
+        match size {
+            0 => {}
+            1..=4 => self.solve_active_fixed::<4>(size),
+            5..=8 => self.solve_active_fixed::<8>(size),
+            _ => self.solve_active_any(size),
+        }
+        // δ = −R − G_{:,A} D y, a row of the block per active point.
+        let deltas = &mut self.scratch[..count];
+        for (d, r) in deltas.iter_mut().zip(&self.residual[..count]) {
+            *d = -r;
+        }
+        for a in 0..size {
+            let row_start = self.active[a] * stride;
+            let row = &self.block[row_start..row_start + count];
+            let weight = self.solution[a];
+            for (d, g) in deltas.iter_mut().zip(row) {
+                *d -= g * weight;
+            }
+        }
+        let mut largest = 0.0f64;
+        for (step, d) in self.steps[..count].iter_mut().zip(deltas.iter()) {
+            *step += d;
+            largest = largest.max(d.abs());
+        }
+        if self.solution[..size].iter().all(|y| y.is_finite()) && largest.is_finite() {
+            largest
+        } else {
+            f64::NAN
+        }
+    }
+
+    /// `(I + D G_AA D) y = −D R_A`, then `y ← D y`, into `solution[..size]`, on `N × N` arrays
+    /// padded with identity rows.
+    fn solve_active_fixed<const N: usize>(&mut self, size: usize) {
+        let stride = self.capacity;
+        let mut matrix = [[0.0; N]; N];
+        let mut y = [0.0; N];
+        for (a, row) in matrix.iter_mut().enumerate() {
+            row[a] = 1.0;
+        }
+        for a in 0..size {
+            let row = &self.block[self.active[a] * stride..];
+            for b in 0..=a {
+                matrix[a][b] += self.roots[a] * row[self.active[b]] * self.roots[b];
+            }
+            y[a] = -self.roots[a] * self.residual[self.active[a]];
+        }
+        ldl_solve_fixed(&mut matrix, &mut y);
+        for a in 0..size {
+            self.solution[a] = y[a] * self.roots[a];
+        }
+    }
+
+    /// [`ContactStep::solve_active_fixed`] for any size, in the heap buffers. The matrix is SPD
+    /// with eigenvalues ≥ 1, so LDLᵀ without pivoting is exact and stable.
+    fn solve_active_any(&mut self, size: usize) {
+        let stride = self.capacity;
+        let matrix = &mut self.matrix[..size * size];
+        for a in 0..size {
+            let row = &self.block[self.active[a] * stride..];
+            for b in 0..=a {
+                matrix[a * size + b] = self.roots[a] * row[self.active[b]] * self.roots[b];
+            }
+            matrix[a * size + a] += 1.0;
+            self.solution[a] = -self.roots[a] * self.residual[self.active[a]];
+        }
+        let solution = &mut self.solution[..size];
+        ldl_solve_in_place(matrix, size, solution, &mut self.scratch[..size]);
+        for (y, root) in solution.iter_mut().zip(&self.roots[..size]) {
+            *y *= root;
+        }
+    }
+
+    /// The contact damping's loss over the step at the last evaluation, J.
+    pub fn damping_loss_j(&self) -> f64 {
+        let count = self.count;
+        self.laws[..count]
+            .iter()
+            .zip(&self.gaps[..count])
+            .zip(&self.steps[..count])
+            .map(|((law, &gap), &step)| law.linear_damping_loss(gap, step))
+            .sum()
+    }
+}
