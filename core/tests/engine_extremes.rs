@@ -99,6 +99,12 @@ fn every_number_set_to(value: f64, instrument: Instrument) -> EngineSettings {
     };
     settings.output_gain_db = value;
     settings.drone.free_tempo_bpm = value;
+    settings.drone.pluck_spacing_beats = value;
+    settings.drone.cycle_pause_beats = value;
+    settings.drone.humanize_timing_s = value;
+    settings.drone.humanize_strength = value;
+    settings.tuning.a4_hz = value;
+    settings.tuning.fine_tune_cents = value;
     let bowed = &mut settings.bowed;
     bowed.pressure = value;
     bowed.bow_velocity_m_s = value;
@@ -135,6 +141,27 @@ fn assert_valid(settings: &EngineSettings) {
     assert_within("gain", settings.output_gain_db, OUTPUT_GAIN_RANGE_DB);
     let tempo = javari_core::engine::drone::TEMPO_RANGE_BPM;
     assert_within("drone tempo", settings.drone.free_tempo_bpm, tempo);
+    use javari_core::engine::{drone, pitch};
+    let d = settings.drone;
+    assert_within(
+        "spacing",
+        d.pluck_spacing_beats,
+        drone::PLUCK_SPACING_RANGE_BEATS,
+    );
+    assert_within("pause", d.cycle_pause_beats, drone::CYCLE_PAUSE_RANGE_BEATS);
+    assert_within(
+        "humanize",
+        d.humanize_timing_s,
+        drone::HUMANIZE_TIMING_RANGE_S,
+    );
+    assert_within(
+        "softening",
+        d.humanize_strength,
+        drone::HUMANIZE_STRENGTH_RANGE,
+    );
+    assert_within("A4", settings.tuning.a4_hz, pitch::A4_RANGE_HZ);
+    let fine = settings.tuning.fine_tune_cents;
+    assert_within("fine tuning", fine, pitch::FINE_TUNE_RANGE_CENTS);
     let bowed = settings.bowed;
     assert_within("bow pressure", bowed.pressure, (0.0, 1.0));
     assert_within(

@@ -10,8 +10,9 @@
 //! - automation: [`CHANGES_PER_SECOND`] parameter changes a second on average
 //!   (`--changes-per-second`), each to a random value
 //!   of one randomly chosen parameter within its range (k_b log-uniform), switches and choices
-//!   included (instrument, drone on/off, first string, tempo sync, bow model, bowed string, body,
-//!   thread, bridge beyond thread), and the host tempo; one change in [`HOSTILE_FRACTION`] sends
+//!   included (instrument, tanpura output, drone on/off, pattern, first string, tempo sync,
+//!   humanize seed, bow model, bowed string, body, thread, bridge beyond thread), and the host
+//!   tempo; one change in [`HOSTILE_FRACTION`] sends
 //!   a value no host should (NaN, ±∞, or far out of range), which the engine must clamp;
 //! - the quality tier stays at `--quality` (the plugin's default, live), unless
 //!   `--automate-quality` adds tier switches to the automation.
@@ -202,6 +203,15 @@ enum Parameter {
     DroneFirstString,
     DroneTempoSync,
     DroneTempo,
+    ReferencePitch,
+    FineTuning,
+    DronePattern,
+    PluckSpacing,
+    CyclePause,
+    HumanizeTiming,
+    HumanizeStrength,
+    HumanizeSeed,
+    TanpuraOutput,
     Instrument,
     BowModel,
     BowedString,
@@ -225,6 +235,9 @@ impl Parameter {
                 | Parameter::DroneEnabled
                 | Parameter::DroneFirstString
                 | Parameter::DroneTempoSync
+                | Parameter::DronePattern
+                | Parameter::HumanizeSeed
+                | Parameter::TanpuraOutput
                 | Parameter::Instrument
                 | Parameter::BowModel
                 | Parameter::BowedString
@@ -232,7 +245,7 @@ impl Parameter {
         )
     }
 
-    const ALL: [Parameter; 26] = [
+    const ALL: [Parameter; 35] = [
         Parameter::ThreadEnabled,
         Parameter::ThreadPosition,
         Parameter::BridgeStiffness,
@@ -249,6 +262,15 @@ impl Parameter {
         Parameter::DroneFirstString,
         Parameter::DroneTempoSync,
         Parameter::DroneTempo,
+        Parameter::ReferencePitch,
+        Parameter::FineTuning,
+        Parameter::DronePattern,
+        Parameter::PluckSpacing,
+        Parameter::CyclePause,
+        Parameter::HumanizeTiming,
+        Parameter::HumanizeStrength,
+        Parameter::HumanizeSeed,
+        Parameter::TanpuraOutput,
         Parameter::Instrument,
         Parameter::BowModel,
         Parameter::BowedString,
@@ -357,11 +379,16 @@ impl SoakScene {
 
     /// Changes one random parameter; returns whether the value sent was hostile.
     fn automate(&mut self) -> bool {
-        use javari_core::engine::drone::TEMPO_RANGE_BPM;
+        use javari_core::engine::drone::{
+            DronePattern, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE,
+            HUMANIZE_TIMING_RANGE_S, PLUCK_SPACING_RANGE_BEATS, TEMPO_RANGE_BPM,
+        };
+        use javari_core::engine::pitch::{A4_RANGE_HZ, FINE_TUNE_RANGE_CENTS};
         use javari_core::engine::preset::{
             BOW_GLIDE_RANGE_S, BOW_POSITION_RANGE, BOW_VELOCITY_RANGE_M_S, BOW_VIBRATO_RANGE_CENTS,
             PLUCK_POSITION_RANGE_M,
         };
+        use javari_core::engine::TanpuraOutput;
         use javari_core::engine::OUTPUT_GAIN_RANGE_DB;
         use javari_core::tanpura::excitation::Pluck;
         use javari_core::tanpura::geometry::ThreadSettings;
@@ -431,6 +458,41 @@ impl SoakScene {
             Parameter::DroneTempo => {
                 let value = number(self, TEMPO_RANGE_BPM);
                 self.settings.drone.free_tempo_bpm = value;
+            }
+            Parameter::ReferencePitch => {
+                let value = number(self, A4_RANGE_HZ);
+                self.settings.tuning.a4_hz = value;
+            }
+            Parameter::FineTuning => {
+                let value = number(self, FINE_TUNE_RANGE_CENTS);
+                self.settings.tuning.fine_tune_cents = value;
+            }
+            Parameter::DronePattern => {
+                s.drone.pattern = DronePattern::ALL[self.random.usize(..DronePattern::ALL.len())];
+            }
+            Parameter::PluckSpacing => {
+                let value = number(self, PLUCK_SPACING_RANGE_BEATS);
+                self.settings.drone.pluck_spacing_beats = value;
+            }
+            Parameter::CyclePause => {
+                let value = number(self, CYCLE_PAUSE_RANGE_BEATS);
+                self.settings.drone.cycle_pause_beats = value;
+            }
+            Parameter::HumanizeTiming => {
+                let value = number(self, HUMANIZE_TIMING_RANGE_S);
+                self.settings.drone.humanize_timing_s = value;
+            }
+            Parameter::HumanizeStrength => {
+                let value = number(self, HUMANIZE_STRENGTH_RANGE);
+                self.settings.drone.humanize_strength = value;
+            }
+            Parameter::HumanizeSeed => s.drone.humanize_seed = self.random.u32(..),
+            Parameter::TanpuraOutput => {
+                s.tanpura_output = if self.random.bool() {
+                    TanpuraOutput::Pickup
+                } else {
+                    TanpuraOutput::Radiated
+                }
             }
             Parameter::Instrument => {
                 s.instrument = if self.random.bool() {

@@ -218,9 +218,38 @@ impl EngineSettings {
                     drone::TEMPO_RANGE_BPM,
                     default.drone.free_tempo_bpm,
                 ),
+                pluck_spacing_beats: clamp_or(
+                    self.drone.pluck_spacing_beats,
+                    drone::PLUCK_SPACING_RANGE_BEATS,
+                    default.drone.pluck_spacing_beats,
+                ),
+                cycle_pause_beats: clamp_or(
+                    self.drone.cycle_pause_beats,
+                    drone::CYCLE_PAUSE_RANGE_BEATS,
+                    default.drone.cycle_pause_beats,
+                ),
+                humanize_timing_s: clamp_or(
+                    self.drone.humanize_timing_s,
+                    drone::HUMANIZE_TIMING_RANGE_S,
+                    default.drone.humanize_timing_s,
+                ),
+                humanize_strength: clamp_or(
+                    self.drone.humanize_strength,
+                    drone::HUMANIZE_STRENGTH_RANGE,
+                    default.drone.humanize_strength,
+                ),
                 ..self.drone
             },
             instrument: self.instrument,
+            tanpura_output: self.tanpura_output,
+            tuning: pitch::Tuning {
+                a4_hz: clamp_or(self.tuning.a4_hz, pitch::A4_RANGE_HZ, default.tuning.a4_hz),
+                fine_tune_cents: clamp_or(
+                    self.tuning.fine_tune_cents,
+                    pitch::FINE_TUNE_RANGE_CENTS,
+                    default.tuning.fine_tune_cents,
+                ),
+            },
             bowed: BowedEngineSettings {
                 player: BowedPlayerSettings {
                     glide_time_s: clamp_or(
