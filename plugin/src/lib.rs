@@ -16,6 +16,7 @@
 
 pub mod editor;
 pub mod params;
+pub mod state;
 
 use editor::channel::{SnapshotChannel, SnapshotPublisher, QUEUE_FRAMES};
 use javari_core::engine::preset::Preset;
@@ -122,6 +123,12 @@ impl Plugin for Javari {
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()
+    }
+
+    /// A saved state from the host is clamped into the parameters' ranges before it is applied
+    /// ([`state::sanitize`]).
+    fn filter_state(state: &mut PluginState) {
+        state::sanitize(state);
     }
 
     fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
