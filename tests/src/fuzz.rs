@@ -198,7 +198,8 @@ impl SettingChange {
             }
             // The cheaper tiers only: Reference costs a second per input.
             SettingChange::Quality(index) => {
-                voice.quality = [Quality::Draft, Quality::Live, Quality::Studio][usize::from(index) % 3]
+                voice.quality =
+                    [Quality::Draft, Quality::Live, Quality::Studio][usize::from(index) % 3]
             }
             SettingChange::PluckPosition(value) => {
                 settings.pluck.position_m = value.scaled(0.05, 0.6)
@@ -329,10 +330,15 @@ pub fn engine_events(bytes: &[u8]) {
             } => {
                 let length = usize::from(length).clamp(1, MAX_SAMPLES_PER_INPUT - rendered);
                 events.clear();
-                events.extend(fuzz_events.iter().take(256).map(|(offset, event)| TimedEvent {
-                    offset: usize::from(*offset),
-                    event: event.engine_event(),
-                }));
+                events.extend(
+                    fuzz_events
+                        .iter()
+                        .take(256)
+                        .map(|(offset, event)| TimedEvent {
+                            offset: usize::from(*offset),
+                            event: event.engine_event(),
+                        }),
+                );
                 events.sort_by_key(|event| event.offset);
                 let block = &mut output[..length];
                 let ((), allocations) = allocations_in(|| engine.process(&events, block));

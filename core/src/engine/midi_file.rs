@@ -96,7 +96,7 @@ impl MidiScore {
     pub fn describe_length(&self) -> String {
         let mut text = format!("its last event is at {}", format_time(self.score.end_s));
         if let Some(place) = self.last_event {
-            text += &format!(" ({place})");
+            text += &format!(", at {place}");
         }
         if let Some(silence) = self.longest_silence {
             text += &format!(
@@ -294,7 +294,9 @@ pub fn parse(bytes: &[u8], file: &str) -> Result<MidiScore, MidiFileError> {
         }
         last_event = Some(event.place);
         if loss_ticks.binary_search(&event.tick).is_ok()
-            && tick_times.last().is_none_or(|(tick, _)| *tick != event.tick)
+            && tick_times
+                .last()
+                .is_none_or(|(tick, _)| *tick != event.tick)
         {
             tick_times.push((event.tick, time_s));
         }
@@ -559,7 +561,9 @@ mod tests {
     fn divisions_and_tempos_that_make_time_meaningless_are_refused() {
         let zero_division = parse(&file_with([0, 0], &[ONE_NOTE]), "z.mid").unwrap_err();
         assert!(
-            zero_division.to_string().starts_with("z.mid: the header's division is 0 ticks"),
+            zero_division
+                .to_string()
+                .starts_with("z.mid: the header's division is 0 ticks"),
             "{zero_division}"
         );
         // SMPTE: −25 frames per second, 0 ticks per frame.
@@ -656,7 +660,10 @@ mod tests {
         let expected_s = 16.777_215 * f64::from((1u32 << 28) - 1);
         assert!((read.score.end_s / expected_s - 1.0).abs() < 1e-12);
         let text = read.describe_length();
-        assert!(text.contains("(track 1, byte 33)"), "{text}");
+        assert!(
+            text.contains("at 4503599342.2 s (1250999.8 h), at track 1, byte 33"),
+            "{text}"
+        );
         assert!(text.contains("nothing happens for"), "{text}");
     }
 
@@ -666,6 +673,10 @@ mod tests {
         bytes[18..22].copy_from_slice(&u32::MAX.to_be_bytes());
         let read = parse(&bytes, "huge.mid").unwrap();
         assert_eq!(read.note_count, 1);
-        assert!(read.warnings[0].contains("cut short"), "{:?}", read.warnings);
+        assert!(
+            read.warnings[0].contains("cut short"),
+            "{:?}",
+            read.warnings
+        );
     }
 }
