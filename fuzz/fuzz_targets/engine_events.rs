@@ -4,10 +4,11 @@
 
 #![no_main]
 
-use javari_tests::allocations::CountingAllocator;
 use libfuzzer_sys::fuzz_target;
 
+/// Aborts on an allocation inside `assert_no_alloc` (the fuzz build has debug assertions, `-a`),
+/// which libFuzzer reports as a crash.
 #[global_allocator]
-static ALLOCATOR: CountingAllocator = CountingAllocator;
+static ALLOCATOR: nice_assert_no_alloc::AllocDisabler = nice_assert_no_alloc::AllocDisabler;
 
 fuzz_target!(|data: &[u8]| javari_tests::fuzz::engine_events(data));

@@ -3,10 +3,6 @@
 
 #![no_main]
 
-use javari_tests::allocations::CountingAllocator;
 use libfuzzer_sys::fuzz_target;
-
-#[global_allocator]
-static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 fuzz_target!(|data: &[u8]| javari_tests::fuzz::preset_text(data));

@@ -12,8 +12,13 @@
 //! - [`engine_events`]: bytes decoded ([`arbitrary`]) into settings, then a stream of events,
 //!   parameter changes, tempo changes, resets and blocks → `Engine::process`: finite output
 //!   within ±[`ENGINE_OUTPUT_BOUND`], and no allocation in any call the audio thread makes.
+//!
+//! No allocation is checked as the plugin's tests check it: each call runs inside
+//! `nice_assert_no_alloc::assert_no_alloc`, and the binary's global allocator (nice-plug's, with
+//! its `assert_process_allocs` feature, or the fuzz target's own `AllocDisabler`) aborts the
+//! process on an allocation there when debug assertions are on. `tests/tests/fuzz_regressions.rs`
+//! checks that the guard is armed.
 
-use crate::allocations::allocations_in;
 use arbitrary::{Arbitrary, Unstructured};
 use javari::params::JavariParams;
 use javari_core::bowed::BowTier;
@@ -25,6 +30,7 @@ use javari_core::engine::{
 };
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::FirstString;
+use nice_assert_no_alloc::assert_no_alloc;
 
 /// The MIDI target's check (see the module doc).
 pub fn midi_file(bytes: &[u8]) {
@@ -341,8 +347,7 @@ pub fn engine_events(bytes: &[u8]) {
                 );
                 events.sort_by_key(|event| event.offset);
                 let block = &mut output[..length];
-                let ((), allocations) = allocations_in(|| engine.process(&events, block));
-                assert_eq!(allocations, 0, "Engine::process allocated");
+                assert_no_alloc(|| engine.process(&events, block));
                 for (index, sample) in block.iter().enumerate() {
                     assert!(
                         sample.is_finite() && sample.abs() <= ENGINE_OUTPUT_BOUND,
@@ -359,17 +364,14 @@ pub fn engine_events(bytes: &[u8]) {
                 for change in changes {
                     change.apply(&mut settings);
                 }
-                let ((), allocations) = allocations_in(|| engine.set_settings(&settings));
-                assert_eq!(allocations, 0, "Engine::set_settings allocated");
+                assert_no_alloc(|| engine.set_settings(&settings));
             }
             Operation::HostTempo(tempo) => {
                 let tempo = tempo.map(|tempo| tempo.scaled(20.0, 300.0));
-                let ((), allocations) = allocations_in(|| engine.set_host_tempo(tempo));
-                assert_eq!(allocations, 0, "Engine::set_host_tempo allocated");
+                assert_no_alloc(|| engine.set_host_tempo(tempo));
             }
             Operation::Reset => {
-                let ((), allocations) = allocations_in(|| engine.reset());
-                assert_eq!(allocations, 0, "Engine::reset allocated");
+                assert_no_alloc(|| engine.reset());
             }
         }
     }

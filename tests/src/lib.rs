@@ -3,7 +3,6 @@
 //!
 //! Regenerate the fixtures with `JAVARI_WRITE_FIXTURES=1 cargo test -p javari-tests fixtures`.
 
-pub mod allocations;
 pub mod fuzz;
 
 use midly::num::{u15, u24, u28, u4, u7};
