@@ -209,8 +209,7 @@ fn check_length(
     let why = read.map_or(String::new(), |read| {
         format!(" ({})", read.describe_length())
     });
-    // `!(a <= b)` so that a NaN length is refused too.
-    if !(length_s <= max_seconds) {
+    if length_s.is_nan() || length_s > max_seconds {
         return Err(format!(
             "{source} would render {} with the tail{why}, longer than --max-seconds {max_seconds}; \
              raise --max-seconds to render it all",
@@ -623,6 +622,25 @@ mod tests {
         wav.commit().unwrap();
         assert_eq!(read_wav(&out).unwrap(), (vec![0.25, -0.5], 44_100.0));
         assert_eq!(file_names(&directory), ["take.wav"]);
+        std::fs::remove_dir_all(&directory).unwrap();
+    }
+
+    #[test]
+    fn the_streamed_wav_has_the_bytes_of_the_whole_signal_written_at_once() {
+        let directory = scratch_directory("streamed");
+        let signal: Vec<f32> = (0..5000).map(|index| (index as f32 * 0.01).sin()).collect();
+        let whole = directory.join("whole.wav");
+        javari_core::engine::wav::write_wav(&whole, &signal, 48_000.0).unwrap();
+        let streamed = directory.join("streamed.wav");
+        let mut wav = PendingWav::create(&streamed, 48_000.0).unwrap();
+        for block in signal.chunks(512) {
+            wav.write(block).unwrap();
+        }
+        wav.commit().unwrap();
+        assert_eq!(
+            std::fs::read(&whole).unwrap(),
+            std::fs::read(&streamed).unwrap()
+        );
         std::fs::remove_dir_all(&directory).unwrap();
     }
 
