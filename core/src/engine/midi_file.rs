@@ -219,6 +219,22 @@ pub fn parse(bytes: &[u8], file: &str) -> Result<MidiScore, MidiFileError> {
         file: file.to_string(),
         reason,
     };
+    // midly reads an SMPTE division's frame rate by negating its high byte as an i8, which
+    // overflows (a panic where overflow is checked) for 0x80; no frame rate is −128, so such a
+    // header is refused here first. The header is at the start, or inside a RIFF (RMID) wrapper.
+    let header_at = if bytes.starts_with(b"RIFF") {
+        bytes.windows(4).position(|window| window == b"MThd")
+    } else {
+        Some(0)
+    };
+    let division_at = header_at.map(|at| at + 12);
+    if division_at.and_then(|at| bytes.get(at)) == Some(&0x80) {
+        return Err(fail(format!(
+            "the header's SMPTE division (byte {}) gives −128 frames per second; only 24, 25, \
+             29.97 and 30 exist",
+            division_at.unwrap_or_default()
+        )));
+    }
     let (header, tracks) = midly::parse(bytes)
         .map_err(|error| fail(format!("not a valid standard MIDI file: {error}")))?;
     let timing = header.timing;
@@ -576,6 +592,16 @@ mod tests {
             tempo.to_string(),
             "t.mid: track 1, byte 26: a set-tempo of 0 µs per beat makes the time of every \
              later event meaningless"
+        );
+    }
+
+    #[test]
+    fn an_smpte_division_of_minus_128_frames_is_refused() {
+        // Found by the midi_file fuzz target: midly's negation of 0x80 overflows.
+        let error = parse(&file_with([0x80, 0x3c], &[ONE_NOTE]), "f.mid").unwrap_err();
+        assert!(
+            error.reason.contains("byte 12) gives −128 frames"),
+            "{error}"
         );
     }
 
