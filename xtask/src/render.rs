@@ -295,8 +295,14 @@ impl PendingWav {
         let name = out.file_name().map_or("render.wav".into(), |name| {
             name.to_string_lossy().into_owned()
         });
-        let file = tempfile::Builder::new()
-            .prefix(&format!(".{name}.partial-"))
+        let prefix = format!(".{name}.partial-");
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix);
+        // A temporary file is private (0600) by default; the output gets the permissions any
+        // new file gets (0666 less the umask), as `File::create` would give it.
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let file = builder
             .tempfile_in(directory)
             .map_err(|error| format!("cannot create a file in {}: {error}", directory.display()))?;
         let (file, temporary) = file.into_parts();
@@ -622,6 +628,12 @@ mod tests {
         wav.commit().unwrap();
         assert_eq!(read_wav(&out).unwrap(), (vec![0.25, -0.5], 44_100.0));
         assert_eq!(file_names(&directory), ["take.wav"]);
+        // The output has the permissions of any new file, not a temporary file's.
+        let created = directory.join("created");
+        std::fs::File::create(&created).unwrap();
+        let permissions = |path: &Path| std::fs::metadata(path).unwrap().permissions();
+        assert_eq!(permissions(&out), permissions(&created));
+        std::fs::remove_file(&created).unwrap();
         std::fs::remove_dir_all(&directory).unwrap();
     }
 
