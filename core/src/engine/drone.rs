@@ -125,7 +125,12 @@ impl DroneSequencer {
             return None;
         }
         let string = self.next_string;
-        let tempo = tempo_bpm.clamp(TEMPO_RANGE_BPM.0, TEMPO_RANGE_BPM.1);
+        // A NaN tempo would make every later pluck time NaN (a pluck at every sample).
+        let tempo = if tempo_bpm.is_nan() {
+            DroneSettings::default().free_tempo_bpm
+        } else {
+            tempo_bpm.clamp(TEMPO_RANGE_BPM.0, TEMPO_RANGE_BPM.1)
+        };
         let beat_samples = 60.0 / tempo * sample_rate_hz;
         self.next_pluck_time = Some(time + CYCLE_GAPS_BEATS[string] * beat_samples);
         self.next_string = (string + 1) % DRONE_STRINGS;

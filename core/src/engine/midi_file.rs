@@ -220,19 +220,17 @@ pub fn parse(bytes: &[u8], file: &str) -> Result<MidiScore, MidiFileError> {
         reason,
     };
     // midly reads an SMPTE division's frame rate by negating its high byte as an i8, which
-    // overflows (a panic where overflow is checked) for 0x80; no frame rate is −128, so such a
-    // header is refused here first. The header is at the start, or inside a RIFF (RMID) wrapper.
-    let header_at = if bytes.starts_with(b"RIFF") {
-        bytes.windows(4).position(|window| window == b"MThd")
-    } else {
-        Some(0)
-    };
-    let division_at = header_at.map(|at| at + 12);
-    if division_at.and_then(|at| bytes.get(at)) == Some(&0x80) {
+    // overflows (a panic where overflow is checked) for 0x80, and it parses every header chunk
+    // it meets (a RIFF wrapper's, a duplicate one). No frame rate is −128, so a file with such a
+    // header chunk anywhere is refused here first (the division is 12 bytes into the chunk).
+    if let Some(at) = bytes
+        .windows(13)
+        .position(|window| window.starts_with(b"MThd") && window[12] == 0x80)
+    {
         return Err(fail(format!(
             "the header's SMPTE division (byte {}) gives −128 frames per second; only 24, 25, \
              29.97 and 30 exist",
-            division_at.unwrap_or_default()
+            at + 12
         )));
     }
     let (header, tracks) = midly::parse(bytes)
