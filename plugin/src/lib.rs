@@ -137,6 +137,7 @@ impl Plugin for Javari {
         self.params.clone()
     }
 
+    /// A saved state from the host is repaired before it is applied ([`state::repair`]).
     fn filter_state(state: &mut PluginState) {
         state::repair(state);
     }

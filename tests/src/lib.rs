@@ -3,6 +3,8 @@
 //!
 //! Regenerate the fixtures with `JAVARI_WRITE_FIXTURES=1 cargo test -p javari-tests fixtures`.
 
+pub mod fuzz;
+
 use midly::num::{u15, u24, u28, u4, u7};
 use midly::{Format, Header, MetaMessage, MidiMessage, Smf, Timing, TrackEvent, TrackEventKind};
 use std::path::PathBuf;

@@ -342,6 +342,50 @@ fn clap_state_round_trip_restores_parameters() {
     assert!((ratio - 0.5).abs() < 0.01, "{ratio}");
 }
 
+#[test]
+fn clap_state_out_of_range_is_clamped_on_load() {
+    // A damaged or hand-edited project: a gain of 1e30 dB and a preset index past the last
+    // preset. nice-plug alone would store both, play at +1e30 dB and panic on the next save
+    // (it reads the enum's ID by index); the plugin's `filter_state` clamps them first.
+    let entry = load_entry();
+    let mut instance = instantiate(entry);
+    let extension = instance
+        .plugin_handle()
+        .get_extension::<PluginState>()
+        .unwrap();
+    let mut saved = Vec::new();
+    extension
+        .save(&instance.plugin_handle(), &mut saved)
+        .expect("save");
+    let text = state_json(&saved);
+    assert!(
+        text.contains("\"preset\":{\"string\":\"custom\"}"),
+        "{text}"
+    );
+    let damaged = edit_parameter(&text, "gain", 1e30).replace(
+        "\"preset\":{\"string\":\"custom\"}",
+        "\"preset\":{\"i32\":99}",
+    );
+    extension
+        .load(
+            &instance.plugin_handle(),
+            &mut state_bytes(&damaged).as_slice(),
+        )
+        .expect("load");
+    let mut resaved = Vec::new();
+    extension
+        .save(&instance.plugin_handle(), &mut resaved)
+        .expect("save after loading the damaged state");
+    let resaved = state_json(&resaved);
+    assert_eq!(parameter_value(&resaved, "gain"), 24.0);
+    assert!(
+        resaved.contains("\"preset\":{\"string\":\"custom\"}"),
+        "{resaved}"
+    );
+    let (signal, _) = play(&mut instance, 44_100.0, 256, 60, 0.5, 0, 0.2);
+    assert!(signal.iter().all(|x| x.is_finite()));
+}
+
 /// nice-plug's CLAP state: the JSON text's length as a little-endian u64, then the JSON, in
 /// which each parameter is `"id":{"f32":value}` (or `bool`, `string`).
 fn state_json(bytes: &[u8]) -> String {

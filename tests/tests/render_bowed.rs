@@ -24,7 +24,9 @@ fn violin() -> EngineSettings {
 }
 
 fn score() -> Score {
-    midi_file::load(&fixtures_dir().join("bowed.mid")).unwrap()
+    midi_file::load(&fixtures_dir().join("bowed.mid"))
+        .unwrap()
+        .score
 }
 
 fn options(block_size: usize) -> RenderOptions {

@@ -18,7 +18,7 @@ fn fixture(name: &str) -> (Fixture, Score) {
         .into_iter()
         .find(|fixture| fixture.file_name == name)
         .unwrap();
-    let score = midi_file::load(&fixtures_dir().join(name)).unwrap();
+    let score = midi_file::load(&fixtures_dir().join(name)).unwrap().score;
     (fixture, score)
 }
 

@@ -1,8 +1,25 @@
 //! `cargo xtask render`: MIDI file (or the built-in demo scene) to a WAV file, through the same
 //! engine the plugin runs (`javari_core::engine::render`).
 //!
-//! Options: `cargo xtask render --help`. The WAV file is mono, 32-bit float at full scale ±1. A
-//! progress bar goes to stderr.
+//! Options: `cargo xtask render --help`. The WAV file is mono, 32-bit float at full scale ±1.
+//!
+//! Bounded work, clear errors:
+//! - the MIDI file's warnings (cut-short tracks, unreadable events, notes that never end;
+//!   `javari_core::engine::midi_file`) are printed before anything else; a file it refuses
+//!   (meaningless time, no notes) is an error;
+//! - a score none of whose notes the instrument can play is refused, and notes it cannot play are
+//!   named in a warning;
+//! - the rendered length is announced before the work starts; a score longer than
+//!   `--max-seconds` (default one hour) is refused with where its time goes, never cut;
+//! - samples are streamed to a temporary file beside the output (`.NAME.partial-XXXXXX`, hidden),
+//!   block by block, so memory does not grow with the length; the file is renamed onto the
+//!   output only when the render succeeded, so a failed or interrupted render never leaves a
+//!   partial WAV or touches the previous one (a render killed outright can leave the hidden
+//!   temporary file, never a damaged output);
+//! - a render that is silent from start to end is an error rather than a quiet WAV of zeros.
+//!
+//! Progress goes to stderr: an indicatif bar on a terminal, a plain line every 10 % otherwise (a
+//! log gets lines, not carriage returns).
 
 use crate::args::number_in;
 use crate::plot::heatmap;
@@ -11,17 +28,17 @@ use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use javari_core::analysis::power_spectrum;
 use javari_core::engine::bowed_stability::bowed_stability;
-use javari_core::engine::midi_file;
-use javari_core::engine::pitch::note_to_hz;
+use javari_core::engine::midi_file::{self, format_time, MidiScore};
+use javari_core::engine::pitch::{note_to_hz, playable_note_hz};
 use javari_core::engine::preset::{Preset, QUALITY_NAMES};
 use javari_core::engine::render::ScoreAction;
-use javari_core::engine::render::{render, render_with, rendered_length, RenderOptions, Score};
-use javari_core::engine::wav::write_wav;
-use javari_core::engine::{EngineEvent, EngineSettings, Instrument, VoiceTask};
+use javari_core::engine::render::{render_blocks, rendered_length, RenderOptions, Score};
+use javari_core::engine::wav::read_wav;
+use javari_core::engine::{EngineEvent, EngineSettings, Instrument, VoiceRunner, VoiceTask};
 use javari_core::tanpura::quality::Quality;
 use rayon::prelude::*;
-use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::io::{BufWriter, IsTerminal};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 #[derive(Debug, Parser)]
@@ -56,7 +73,17 @@ pub struct RenderArgs {
     /// for any number.
     #[arg(long, value_name = "N", value_parser = number_in(1usize, 256))]
     jobs: Option<usize>,
+    /// Longest render allowed, s (1 to 86400; default one hour): a score whose rendered length
+    /// (its last event plus the tail) is longer is refused before any work, with where its time
+    /// goes; it is never cut short.
+    #[arg(long, value_name = "S", default_value_t = 3600.0, value_parser = number_in(1.0, 86_400.0))]
+    max_seconds: f64,
 }
+
+/// Largest WAV data chunk: its length field has 32 bits.
+const WAV_MAX_DATA_BYTES: u64 = u32::MAX as u64 - 44;
+/// Bytes per sample of the output (mono 32-bit float).
+const WAV_BYTES_PER_SAMPLE: u64 = 4;
 
 pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let RenderArgs {
@@ -69,22 +96,36 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         tail_seconds: tail_s,
         plot,
         jobs,
+        max_seconds,
     } = args;
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
     let quality = Quality::from_name(&quality);
 
-    let (score, default_out) = match &midi {
+    let (read, default_out) = match &midi {
         Some(path) => {
             let stem = path
                 .file_stem()
                 .map_or("render".into(), |stem| stem.to_string_lossy().into_owned());
             (
-                midi_file::load(path)?,
+                Some(midi_file::load(path)?),
                 PathBuf::from(format!("out/{stem}.wav")),
             )
         }
-        None => (Score::demo(), PathBuf::from("out/demo.wav")),
+        None => (None, PathBuf::from("out/demo.wav")),
     };
+    let source = midi
+        .as_deref()
+        .map_or("the demo scene".to_string(), |path| {
+            path.display().to_string()
+        });
+    if let Some(read) = &read {
+        for warning in &read.warnings {
+            eprintln!("warning: {source}: {warning}");
+        }
+    }
+    let score = read
+        .as_ref()
+        .map_or_else(Score::demo, |read| read.score.clone());
     let out = out.unwrap_or(default_out);
     let mut settings = match &preset_path {
         Some(path) => Preset::load(path)?.settings,
@@ -93,6 +134,7 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(quality) = quality {
         settings.voice.quality = quality;
     }
+    check_playable_notes(&settings, &score, &source)?;
     warn_if_bowed_preset_is_unstable(&settings, &score);
     let options = RenderOptions {
         sample_rate_hz,
@@ -102,12 +144,16 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
 
     let total = rendered_length(&score, &options);
+    let length_s = score.end_s + tail_s;
+    check_length(
+        length_s,
+        max_seconds,
+        sample_rate_hz,
+        &source,
+        read.as_ref(),
+    )?;
     eprintln!(
-        "rendering {} ({:.1} s at {} Hz, {} quality, {jobs} thread{}) to {}",
-        midi.as_deref()
-            .map_or("the demo scene".to_string(), |path| path
-                .display()
-                .to_string()),
+        "rendering {source} ({:.1} s at {} Hz, {} quality, {jobs} thread{}) to {}",
         total as f64 / sample_rate_hz,
         sample_rate_hz,
         settings.voice.quality.name(),
@@ -115,49 +161,284 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         out.display()
     );
     let started = Instant::now();
-    let bar = progress_bar(total);
-    let signal = render_on(jobs, &settings, &score, &options, &mut |done, _| {
-        bar.set_position(done as u64)
+    let mut progress = Progress::new(total, sample_rate_hz);
+    let mut wav = PendingWav::create(&out, sample_rate_hz)?;
+    let mut peak = 0.0f32;
+    let mut written = 0usize;
+    render_on(jobs, &settings, &score, &options, &mut |block| {
+        peak = block.iter().fold(peak, |peak, x| peak.max(x.abs()));
+        written += block.len();
+        progress.update(written);
+        wav.write(block)
     })?;
-    bar.finish_and_clear();
+    progress.finish();
+    if peak == 0.0 {
+        return Err(format!(
+            "{source}: the render is silent from start to end ({:.1} s), so no file is written; \
+             check that the preset's instrument plays the file's notes",
+            total as f64 / sample_rate_hz
+        )
+        .into());
+    }
+    wav.commit()?;
     let elapsed_s = started.elapsed().as_secs_f64();
-    write_wav(&out, &signal, sample_rate_hz)?;
-    let peak = signal.iter().fold(0.0f32, |peak, x| peak.max(x.abs()));
     eprintln!(
-        "wrote {}: {} samples, peak {:.1} dBFS, {:.2} s compute, real-time factor {:.2}",
+        "wrote {}: {written} samples, peak {:.1} dBFS, {:.2} s compute, real-time factor {:.2}",
         out.display(),
-        signal.len(),
         20.0 * f64::from(peak).log10(),
         elapsed_s,
-        (signal.len() as f64 / sample_rate_hz) / elapsed_s
+        (written as f64 / sample_rate_hz) / elapsed_s
     );
     if let Some(plot) = plot {
+        let (signal, _) = read_wav(&out)?;
         write_spectrogram(&plot, &signal, sample_rate_hz)?;
         eprintln!("wrote the spectrogram {}", plot.display());
     }
     Ok(())
 }
 
-/// [`render`] with the voices of each segment on `jobs` threads (rayon); one job renders on this
-/// thread exactly as the plugin does. The voices' outputs are summed in a fixed order
+/// Refuses a render longer than `max_seconds` or than a WAV file holds, saying where a MIDI
+/// file's time goes.
+fn check_length(
+    length_s: f64,
+    max_seconds: f64,
+    sample_rate_hz: f64,
+    source: &str,
+    read: Option<&MidiScore>,
+) -> Result<(), String> {
+    let why = read.map_or(String::new(), |read| {
+        format!(" ({})", read.describe_length())
+    });
+    if length_s.is_nan() || length_s > max_seconds {
+        return Err(format!(
+            "{source} would render {} with the tail{why}, longer than --max-seconds {max_seconds}; \
+             raise --max-seconds to render it all",
+            format_time(length_s)
+        ));
+    }
+    let bytes = length_s * sample_rate_hz * WAV_BYTES_PER_SAMPLE as f64;
+    if bytes > WAV_MAX_DATA_BYTES as f64 {
+        return Err(format!(
+            "{source} would render {} at {sample_rate_hz} Hz, {:.1} GB of samples, more than a \
+             WAV file holds (4 GB); lower --sample-rate or shorten the file",
+            format_time(length_s),
+            bytes / 1e9
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a score none of whose notes the tanpura can play (they would render silence), and
+/// warns about the notes it cannot play. The bowed string and the drone play any note they get.
+fn check_playable_notes(
+    settings: &EngineSettings,
+    score: &Score,
+    source: &str,
+) -> Result<(), String> {
+    if settings.instrument != Instrument::Tanpura || settings.drone.enabled {
+        return Ok(());
+    }
+    let notes: Vec<u8> = score
+        .events
+        .iter()
+        .filter_map(|event| match event.action {
+            ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }) if velocity > 0.0 => {
+                Some(note)
+            }
+            _ => None,
+        })
+        .collect();
+    let unplayable: Vec<u8> = notes
+        .iter()
+        .copied()
+        .filter(|&note| playable_note_hz(note).is_none())
+        .collect();
+    if unplayable.is_empty() {
+        return Ok(());
+    }
+    let (lowest, highest) = (
+        unplayable.iter().min().copied().unwrap_or(0),
+        unplayable.iter().max().copied().unwrap_or(0),
+    );
+    let what = format!(
+        "{} of its {} notes (from note {lowest}, {:.1} Hz, to note {highest}, {:.1} Hz) lie \
+         outside the tanpura's range, notes 16 to 95 (20 to 2000 Hz), and are not played",
+        unplayable.len(),
+        notes.len(),
+        note_to_hz(lowest),
+        note_to_hz(highest)
+    );
+    if unplayable.len() == notes.len() {
+        return Err(format!("{source}: nothing to play: {what}"));
+    }
+    eprintln!("warning: {source}: {what}");
+    Ok(())
+}
+
+/// A WAV file being written: samples go to a temporary file in the output's directory
+/// (`.NAME.partial-XXXXXX`), renamed onto the output by [`PendingWav::commit`]. Dropped without a
+/// commit (an error, a panic), the temporary file is removed and the output is untouched.
+struct PendingWav {
+    writer: hound::WavWriter<BufWriter<std::fs::File>>,
+    temporary: tempfile::TempPath,
+    out: PathBuf,
+}
+
+impl PendingWav {
+    fn create(out: &Path, sample_rate_hz: f64) -> Result<Self, String> {
+        let directory = match out.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => parent,
+            _ => Path::new("."),
+        };
+        std::fs::create_dir_all(directory)
+            .map_err(|error| format!("cannot create {}: {error}", directory.display()))?;
+        let name = out.file_name().map_or("render.wav".into(), |name| {
+            name.to_string_lossy().into_owned()
+        });
+        let prefix = format!(".{name}.partial-");
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix);
+        // A temporary file is private (0600) by default; the output gets the permissions any
+        // new file gets (0666 less the umask), as `File::create` would give it.
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let file = builder
+            .tempfile_in(directory)
+            .map_err(|error| format!("cannot create a file in {}: {error}", directory.display()))?;
+        let (file, temporary) = file.into_parts();
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: sample_rate_hz.round() as u32,
+            bits_per_sample: 32,
+            sample_format: hound::SampleFormat::Float,
+        };
+        let writer = hound::WavWriter::new(BufWriter::new(file), spec)
+            .map_err(|error| format!("cannot write {}: {error}", temporary.display()))?;
+        Ok(Self {
+            writer,
+            temporary,
+            out: out.to_path_buf(),
+        })
+    }
+
+    fn write(&mut self, samples: &[f32]) -> Result<(), String> {
+        for &sample in samples {
+            self.writer
+                .write_sample(sample)
+                .map_err(|error| format!("cannot write {}: {error}", self.out.display()))?;
+        }
+        Ok(())
+    }
+
+    /// Completes the WAV header and renames the file onto the output.
+    fn commit(self) -> Result<(), String> {
+        let fail =
+            |error: &dyn std::fmt::Display| format!("cannot write {}: {error}", self.out.display());
+        self.writer.finalize().map_err(|error| fail(&error))?;
+        self.temporary
+            .persist(&self.out)
+            .map_err(|error| fail(&error))
+    }
+}
+
+/// Render progress on stderr: an indicatif bar on a terminal; elsewhere (a log, CI) a plain line
+/// at every tenth of the work, so that a log never fills with carriage-return updates.
+enum Progress {
+    Bar(ProgressBar),
+    Lines {
+        total: usize,
+        sample_rate_hz: f64,
+        next_tenth: usize,
+    },
+}
+
+impl Progress {
+    fn new(total: usize, sample_rate_hz: f64) -> Self {
+        if std::io::stderr().is_terminal() {
+            let bar =
+                ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+            bar.set_style(
+                ProgressStyle::with_template("[{bar:40}] {percent:>3}%  {eta} left")
+                    .expect("a valid template")
+                    .progress_chars("#> "),
+            );
+            Progress::Bar(bar)
+        } else {
+            Progress::Lines {
+                total,
+                sample_rate_hz,
+                next_tenth: 1,
+            }
+        }
+    }
+
+    fn update(&mut self, done: usize) {
+        match self {
+            Progress::Bar(bar) => bar.set_position(done as u64),
+            Progress::Lines {
+                total,
+                sample_rate_hz,
+                next_tenth,
+            } => {
+                if let Some(line) = progress_line(done, *total, *sample_rate_hz, next_tenth) {
+                    eprintln!("{line}");
+                }
+            }
+        }
+    }
+
+    fn finish(&self) {
+        if let Progress::Bar(bar) = self {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// The plain progress line due when `done` of `total` samples are rendered, if it passed the
+/// next tenth (one line per call even when a block jumps several tenths); moves `next_tenth` on.
+fn progress_line(
+    done: usize,
+    total: usize,
+    sample_rate_hz: f64,
+    next_tenth: &mut usize,
+) -> Option<String> {
+    let tenths = (done as u128 * 10 / total.max(1) as u128) as usize;
+    if *next_tenth > 10 || tenths < *next_tenth {
+        return None;
+    }
+    *next_tenth = tenths + 1;
+    Some(format!(
+        "rendered {}% ({:.1} of {:.1} s)",
+        tenths * 10,
+        done as f64 / sample_rate_hz,
+        total as f64 / sample_rate_hz
+    ))
+}
+
+/// [`render_blocks`] with the voices of each segment on `jobs` threads (rayon); one job renders
+/// on this thread exactly as the plugin does. The voices' outputs are summed in a fixed order
 /// ([`javari_core::engine::Engine::process_with`]), so the signal does not depend on `jobs`.
 fn render_on(
     jobs: usize,
     settings: &EngineSettings,
     score: &Score,
     options: &RenderOptions,
-    progress: &mut (dyn FnMut(usize, usize) + Send),
-) -> Result<Vec<f32>, rayon::ThreadPoolBuildError> {
+    emit: &mut (dyn FnMut(&[f32]) -> Result<(), String> + Send),
+) -> Result<(), String> {
     if jobs <= 1 {
-        return Ok(render(settings, score, options, progress));
+        return render_blocks(settings, score, options, None, emit);
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .map_err(|error| format!("cannot start {jobs} threads: {error}"))?;
     // The whole render runs inside the pool, so that handing out a segment's voices is a cheap
     // fork-join among its threads.
-    Ok(pool.install(|| {
+    pool.install(|| {
         let runner = |tasks: &mut [VoiceTask<'_>]| tasks.par_iter_mut().for_each(VoiceTask::run);
-        render_with(settings, score, options, &runner, progress)
-    }))
+        let runner: VoiceRunner<'_> = &runner;
+        render_blocks(settings, score, options, Some(runner), emit)
+    })
 }
 
 /// Frame length and hop of the spectrogram, samples.
@@ -245,21 +526,6 @@ fn warn_if_bowed_preset_is_unstable(settings: &EngineSettings, score: &Score) {
     }
 }
 
-/// The render's progress bar on stderr (indicatif), hidden when stderr is not a terminal (a log
-/// file or CI gets the summary lines only).
-fn progress_bar(total: usize) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("[{bar:40}] {percent:>3}%  {eta} left")
-            .expect("a valid template")
-            .progress_chars("#> "),
-    );
-    bar
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -279,13 +545,222 @@ mod tests {
             ..RenderOptions::default()
         };
         let bits = |jobs| {
-            let signal = render_on(jobs, &settings, &score, &options, &mut |_, _| {}).unwrap();
-            signal.iter().map(|x| x.to_bits()).collect::<Vec<u32>>()
+            let mut bits = Vec::new();
+            render_on(jobs, &settings, &score, &options, &mut |block| {
+                bits.extend(block.iter().map(|x| x.to_bits()));
+                Ok(())
+            })
+            .unwrap();
+            bits
         };
         let one = bits(1);
         assert!(one.iter().any(|&x| f32::from_bits(x) != 0.0));
         for jobs in [2, 3, 8] {
             assert!(one == bits(jobs), "{jobs} jobs differ from one");
         }
+    }
+
+    /// A fresh directory for one test's files.
+    fn scratch_directory(name: &str) -> PathBuf {
+        let directory =
+            std::env::temp_dir().join(format!("javari-render-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&directory);
+        std::fs::create_dir_all(&directory).unwrap();
+        directory
+    }
+
+    fn file_names(directory: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(directory)
+            .unwrap()
+            .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    }
+
+    /// A one-track MIDI file (480 ticks per beat) holding `events` after its header.
+    fn midi_bytes(events: &[u8]) -> Vec<u8> {
+        let mut bytes = b"MThd\0\0\0\x06\0\0\0\x01\x01\xe0MTrk".to_vec();
+        bytes.extend_from_slice(&(events.len() as u32).to_be_bytes());
+        bytes.extend_from_slice(events);
+        bytes
+    }
+
+    /// Delta 0, note-on C3; 0.1 s (96 ticks) later its note-off; end of track.
+    const SHORT_NOTE: &[u8] = b"\x00\x90\x30\x64\x60\x80\x30\x00\x00\xff\x2f\x00";
+
+    fn render_args(midi: &Path, out: &Path, extra: &[&str]) -> RenderArgs {
+        let mut line = vec![
+            "render".to_string(),
+            "--midi".to_string(),
+            midi.display().to_string(),
+            "--out".to_string(),
+            out.display().to_string(),
+            "--quality".to_string(),
+            "draft".to_string(),
+            "--tail-seconds".to_string(),
+            "0.1".to_string(),
+            "--jobs".to_string(),
+            "1".to_string(),
+        ];
+        line.extend(extra.iter().map(|arg| arg.to_string()));
+        RenderArgs::try_parse_from(line).unwrap()
+    }
+
+    #[test]
+    fn an_abandoned_wav_leaves_the_previous_file_and_no_temporary_file() {
+        let directory = scratch_directory("abandoned");
+        let out = directory.join("take.wav");
+        std::fs::write(&out, b"the previous render").unwrap();
+        let mut wav = PendingWav::create(&out, 44_100.0).unwrap();
+        wav.write(&[0.5; 1000]).unwrap();
+        assert_eq!(
+            file_names(&directory).len(),
+            2,
+            "the temporary file is beside the output"
+        );
+        drop(wav);
+        assert_eq!(std::fs::read(&out).unwrap(), b"the previous render");
+        assert_eq!(file_names(&directory), ["take.wav"]);
+
+        let mut wav = PendingWav::create(&out, 44_100.0).unwrap();
+        wav.write(&[0.25, -0.5]).unwrap();
+        wav.commit().unwrap();
+        assert_eq!(read_wav(&out).unwrap(), (vec![0.25, -0.5], 44_100.0));
+        assert_eq!(file_names(&directory), ["take.wav"]);
+        // The output has the permissions of any new file, not a temporary file's.
+        let created = directory.join("created");
+        std::fs::File::create(&created).unwrap();
+        let permissions = |path: &Path| std::fs::metadata(path).unwrap().permissions();
+        assert_eq!(permissions(&out), permissions(&created));
+        std::fs::remove_file(&created).unwrap();
+        std::fs::remove_dir_all(&directory).unwrap();
+    }
+
+    #[test]
+    fn the_streamed_wav_has_the_bytes_of_the_whole_signal_written_at_once() {
+        let directory = scratch_directory("streamed");
+        let signal: Vec<f32> = (0..5000).map(|index| (index as f32 * 0.01).sin()).collect();
+        let whole = directory.join("whole.wav");
+        javari_core::engine::wav::write_wav(&whole, &signal, 48_000.0).unwrap();
+        let streamed = directory.join("streamed.wav");
+        let mut wav = PendingWav::create(&streamed, 48_000.0).unwrap();
+        for block in signal.chunks(512) {
+            wav.write(block).unwrap();
+        }
+        wav.commit().unwrap();
+        assert_eq!(
+            std::fs::read(&whole).unwrap(),
+            std::fs::read(&streamed).unwrap()
+        );
+        std::fs::remove_dir_all(&directory).unwrap();
+    }
+
+    #[test]
+    fn a_refused_render_leaves_the_previous_file_untouched() {
+        let directory = scratch_directory("refused");
+        let out = directory.join("song.wav");
+        std::fs::write(&out, b"the previous render").unwrap();
+        let cases: [(&str, Vec<u8>, &[&str], &str); 4] = [
+            // A controller and a silent note-on: no note at all.
+            (
+                "quiet.mid",
+                midi_bytes(b"\x00\xb0\x07\x64\x00\x90\x30\x00\x00\xff\x2f\x00"),
+                &[],
+                "no notes",
+            ),
+            // Only note 10 (14.6 Hz), below the tanpura's range.
+            (
+                "low.mid",
+                midi_bytes(b"\x00\x90\x0a\x64\x60\x80\x0a\x00\x00\xff\x2f\x00"),
+                &[],
+                "nothing to play",
+            ),
+            // The note-off 2^28 − 1 ticks (about 78 hours at 120 bpm) after the note-on.
+            (
+                "far.mid",
+                midi_bytes(b"\x00\x90\x30\x64\xff\xff\xff\x7f\x80\x30\x00\x00\xff\x2f\x00"),
+                &[],
+                "longer than --max-seconds 3600",
+            ),
+            // A note of 2 s (1920 ticks) and --max-seconds 1.
+            (
+                "two-seconds.mid",
+                midi_bytes(b"\x00\x90\x30\x64\x8f\x00\x80\x30\x00\x00\xff\x2f\x00"),
+                &["--max-seconds", "1"],
+                "2.10 s with the tail (its last event is at 2.00 s, at track 1, byte 31;",
+            ),
+        ];
+        for (name, bytes, extra, expected) in cases {
+            let midi = directory.join(name);
+            std::fs::write(&midi, bytes).unwrap();
+            let started = Instant::now();
+            let error = run(render_args(&midi, &out, extra))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                started.elapsed().as_secs_f64() < 1.0,
+                "{name} took long to refuse"
+            );
+            assert!(error.contains(expected), "{name}: {error}");
+            assert!(error.contains(name), "{name}: {error}");
+            std::fs::remove_file(&midi).unwrap();
+            assert_eq!(
+                std::fs::read(&out).unwrap(),
+                b"the previous render",
+                "{name}"
+            );
+            assert_eq!(file_names(&directory), ["song.wav"], "{name}");
+        }
+        std::fs::remove_dir_all(&directory).unwrap();
+    }
+
+    #[test]
+    fn a_file_cut_short_renders_what_was_read() {
+        let directory = scratch_directory("cut");
+        let midi = directory.join("cut.mid");
+        // Cut inside the note-off: the note is read, its end is lost.
+        let whole = midi_bytes(SHORT_NOTE);
+        std::fs::write(&midi, &whole[..whole.len() - 6]).unwrap();
+        let out = directory.join("cut.wav");
+        run(render_args(&midi, &out, &[])).unwrap();
+        let (signal, rate) = read_wav(&out).unwrap();
+        assert_eq!(rate, 44_100.0);
+        // The note-on at 0 s is the last event read: the tail alone follows it.
+        assert_eq!(signal.len(), 4411);
+        assert!(signal.iter().any(|&x| x != 0.0));
+        assert_eq!(file_names(&directory), ["cut.mid", "cut.wav"]);
+        std::fs::remove_dir_all(&directory).unwrap();
+    }
+
+    #[test]
+    fn a_log_gets_a_plain_line_per_tenth() {
+        let mut next_tenth = 1;
+        let lines: Vec<String> = (1..=40)
+            .filter_map(|block| progress_line(block * 25, 1000, 100.0, &mut next_tenth))
+            .collect();
+        assert_eq!(lines.len(), 10, "{lines:?}");
+        assert_eq!(lines[0], "rendered 10% (1.0 of 10.0 s)");
+        assert_eq!(lines[9], "rendered 100% (10.0 of 10.0 s)");
+        assert!(lines.iter().all(|line| !line.contains('\r')));
+        // A block that jumps several tenths gives one line.
+        let mut next_tenth = 1;
+        assert_eq!(
+            progress_line(700, 1000, 100.0, &mut next_tenth).as_deref(),
+            Some("rendered 70% (7.0 of 10.0 s)")
+        );
+        assert_eq!(progress_line(750, 1000, 100.0, &mut next_tenth), None);
+    }
+
+    #[test]
+    fn max_seconds_defaults_to_an_hour_and_is_checked() {
+        let args = RenderArgs::try_parse_from(["render"]).unwrap();
+        assert_eq!(args.max_seconds, 3600.0);
+        assert!(RenderArgs::try_parse_from(["render", "--max-seconds", "0"]).is_err());
+        assert!(check_length(3600.0, 3600.0, 44_100.0, "x", None).is_ok());
+        let error = check_length(f64::NAN, 3600.0, 44_100.0, "x", None).unwrap_err();
+        assert!(error.contains("--max-seconds"), "{error}");
+        let error = check_length(80_000.0, 86_400.0, 192_000.0, "x", None).unwrap_err();
+        assert!(error.contains("more than a WAV file holds"), "{error}");
     }
 }

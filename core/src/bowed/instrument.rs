@@ -221,8 +221,24 @@ impl BowedInstrument {
         Ok(instrument)
     }
 
-    /// Applies player settings; allocation-free.
-    pub fn set_settings(&mut self, settings: BowedPlayerSettings) {
+    /// Applies player settings; allocation-free. A NaN or negative time, rate, depth or range
+    /// takes the default's value (a NaN glide would make the pitch NaN).
+    pub fn set_settings(&mut self, mut settings: BowedPlayerSettings) {
+        let default = BowedPlayerSettings::default();
+        for (value, fallback) in [
+            (&mut settings.glide_time_s, default.glide_time_s),
+            (&mut settings.vibrato_rate_hz, default.vibrato_rate_hz),
+            (&mut settings.max_vibrato_cents, default.max_vibrato_cents),
+            (
+                &mut settings.pitch_bend_range_semitones,
+                default.pitch_bend_range_semitones,
+            ),
+            (&mut settings.bow_lift_time_s, default.bow_lift_time_s),
+        ] {
+            if !(value.is_finite() && *value >= 0.0) {
+                *value = fallback;
+            }
+        }
         if settings.tier != self.settings.tier {
             self.rounded.reset();
             self.table.reset();

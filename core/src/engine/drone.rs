@@ -116,6 +116,15 @@ pub fn string_ratios(
     }
 }
 
+/// `value` within `range`; NaN takes `fallback`.
+fn within(value: f64, (low, high): (f64, f64), fallback: f64) -> f64 {
+    if value.is_nan() {
+        fallback
+    } else {
+        value.clamp(low, high)
+    }
+}
+
 /// One due pluck: which string and how strong (1: the full pluck).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DronePluck {
@@ -250,27 +259,32 @@ impl DroneSequencer {
         let nominal = self.next_pluck_time?;
         let count = settings.pattern.string_count();
         let string = self.next_string.min(count - 1);
-        let tempo = tempo_bpm.clamp(TEMPO_RANGE_BPM.0, TEMPO_RANGE_BPM.1);
+        // A NaN would make every later pluck time NaN (a pluck at every sample): it takes the
+        // default instead.
+        let defaults = DroneSettings::default();
+        let tempo = within(tempo_bpm, TEMPO_RANGE_BPM, defaults.free_tempo_bpm);
         if tempo != self.anchor_tempo_bpm {
             self.anchor_time = nominal;
             self.anchor_tempo_bpm = tempo;
             self.beats_since_anchor = 0.0;
         }
-        let spacing = settings
-            .pluck_spacing_beats
-            .clamp(PLUCK_SPACING_RANGE_BEATS.0, PLUCK_SPACING_RANGE_BEATS.1);
-        let pause = settings
-            .cycle_pause_beats
-            .clamp(CYCLE_PAUSE_RANGE_BEATS.0, CYCLE_PAUSE_RANGE_BEATS.1);
+        let spacing = within(
+            settings.pluck_spacing_beats,
+            PLUCK_SPACING_RANGE_BEATS,
+            defaults.pluck_spacing_beats,
+        );
+        let pause = within(
+            settings.cycle_pause_beats,
+            CYCLE_PAUSE_RANGE_BEATS,
+            defaults.cycle_pause_beats,
+        );
         let last = string + 1 >= count;
         let gap = spacing + if last { pause } else { 0.0 };
         self.beats_since_anchor += gap;
         self.next_pluck_time =
             Some(self.anchor_time + self.beats_since_anchor * 60.0 * sample_rate_hz / tempo);
         self.next_string = if last { 0 } else { string + 1 };
-        let softening = settings
-            .humanize_strength
-            .clamp(HUMANIZE_STRENGTH_RANGE.0, HUMANIZE_STRENGTH_RANGE.1);
+        let softening = within(settings.humanize_strength, HUMANIZE_STRENGTH_RANGE, 0.0);
         let strength = 1.0 - softening * split_mix(settings.humanize_seed, self.pluck_index, 1);
         self.pluck_index += 1;
         Some(DronePluck { string, strength })

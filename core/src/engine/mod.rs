@@ -754,7 +754,14 @@ impl Engine {
             let scale = 1.0 / BOWED_NEWTONS_AT_FULL_SCALE;
             let bowed = self.bowed_mut();
             for sample in output.iter_mut() {
-                *sample += (bowed.next_sample() * scale) as f32;
+                let value = (bowed.next_sample() * scale) as f32;
+                if !value.is_finite() {
+                    // Fail soft, as for a tanpura voice: a bowed string that blew up is
+                    // silenced and restarts at rest.
+                    bowed.reset();
+                    break;
+                }
+                *sample += value;
             }
         }
         let release = self.level_release;

@@ -96,12 +96,14 @@ pub fn time_to_sample(time_s: f64, sample_rate_hz: f64) -> usize {
     (time_s.max(0.0) * sample_rate_hz).round() as usize
 }
 
-/// Number of samples [`render`] produces.
+/// Number of samples [`render`] produces (saturating: a score that would last longer than
+/// memory could hold gives `usize::MAX`, which callers refuse long before rendering).
 pub fn rendered_length(score: &Score, options: &RenderOptions) -> usize {
     time_to_sample(
         score.end_s + options.tail_s.max(0.0),
         options.sample_rate_hz,
-    ) + 1
+    )
+    .saturating_add(1)
 }
 
 /// Renders `score` with `settings` to a mono signal at full scale ±1. `progress(done, total)`
@@ -112,7 +114,7 @@ pub fn render(
     options: &RenderOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Vec<f32> {
-    render_inner(settings, score, options, None, progress)
+    collect(settings, score, options, None, progress)
 }
 
 /// [`render`] with the voices run by `runner` ([`Engine::process_with`]), e.g. on a thread pool;
@@ -124,25 +126,50 @@ pub fn render_with(
     runner: VoiceRunner<'_>,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Vec<f32> {
-    render_inner(settings, score, options, Some(runner), progress)
+    collect(settings, score, options, Some(runner), progress)
 }
 
-fn render_inner(
+/// The whole signal of [`render_blocks`] in memory.
+fn collect(
     settings: &EngineSettings,
     score: &Score,
     options: &RenderOptions,
     runner: Option<VoiceRunner<'_>>,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Vec<f32> {
+    let total = rendered_length(score, options);
+    let mut output = Vec::with_capacity(total);
+    let streamed: Result<(), std::convert::Infallible> =
+        render_blocks(settings, score, options, runner, &mut |block| {
+            output.extend_from_slice(block);
+            progress(output.len(), total);
+            Ok(())
+        });
+    let Ok(()) = streamed;
+    output
+}
+
+/// Renders `score` block by block, handing each block's samples to `emit` as soon as they are
+/// computed (the renderer streams them to disk, so memory does not grow with the score's
+/// length). The blocks are those [`render`] computes, so the samples are bit-identical to its
+/// signal; `runner` runs the voices as in [`render_with`]. An error from `emit` stops the render
+/// and is returned.
+pub fn render_blocks<E>(
+    settings: &EngineSettings,
+    score: &Score,
+    options: &RenderOptions,
+    runner: Option<VoiceRunner<'_>>,
+    emit: &mut dyn FnMut(&[f32]) -> Result<(), E>,
+) -> Result<(), E> {
     let mut engine = Engine::new(settings, options.sample_rate_hz, options.voice_count);
     let total = rendered_length(score, options);
-    let mut output = vec![0.0f32; total];
     let block_size = options.block_size.max(1);
+    let mut output = vec![0.0f32; block_size];
     let mut block_events: Vec<TimedEvent> = Vec::with_capacity(MAX_EVENTS_PER_CALL);
     let mut next_event = 0;
     let mut start = 0;
     while start < total {
-        let block_end = (start + block_size).min(total);
+        let block_end = start + block_size.min(total - start);
         // A block is cut short at a tempo change (the host reports tempo per block) or when it
         // holds more events than one call takes.
         let mut end = block_end;
@@ -174,14 +201,15 @@ fn render_inner(
             }
             next_event += 1;
         }
+        let block = &mut output[..end - start];
         match runner {
-            None => engine.process(&block_events, &mut output[start..end]),
-            Some(runner) => engine.process_with(&block_events, &mut output[start..end], runner),
+            None => engine.process(&block_events, block),
+            Some(runner) => engine.process_with(&block_events, block, runner),
         }
+        emit(block)?;
         start = end;
-        progress(start, total);
     }
-    output
+    Ok(())
 }
 
 #[cfg(test)]
@@ -227,6 +255,52 @@ mod tests {
         assert!(in_turn.iter().any(|&sample| sample != 0.0));
         let bits = |signal: &[f32]| signal.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&in_turn), bits(&reversed));
+    }
+
+    #[test]
+    fn blocks_stream_the_same_bits_as_the_whole_signal() {
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = crate::tanpura::quality::Quality::Draft;
+        let mut score = Score::default();
+        score.note(0.0, 0.02, 48, 0.9);
+        score.push(0.013, ScoreAction::Tempo(90.0));
+        let options = RenderOptions {
+            tail_s: 0.03,
+            block_size: 300,
+            ..RenderOptions::default()
+        };
+        let whole = render(&settings, &score, &options, &mut |_, _| {});
+        let mut streamed = Vec::new();
+        let mut longest_block = 0;
+        let result: Result<(), ()> =
+            render_blocks(&settings, &score, &options, None, &mut |block| {
+                longest_block = longest_block.max(block.len());
+                streamed.extend_from_slice(block);
+                Ok(())
+            });
+        result.unwrap();
+        assert_eq!(longest_block, 300);
+        let bits = |signal: &[f32]| signal.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&whole), bits(&streamed));
+        // An error from the sink stops the render at once.
+        let mut calls = 0;
+        let stopped = render_blocks(&settings, &score, &options, None, &mut |_| {
+            calls += 1;
+            Err("disk full")
+        });
+        assert_eq!((stopped, calls), (Err("disk full"), 1));
+    }
+
+    #[test]
+    fn the_length_of_an_absurdly_long_score_saturates() {
+        let score = Score {
+            events: Vec::new(),
+            end_s: 1e300,
+        };
+        assert_eq!(
+            rendered_length(&score, &RenderOptions::default()),
+            usize::MAX
+        );
     }
 
     #[test]

@@ -329,3 +329,44 @@ fn reference_pitch_and_fine_tuning_tune_notes_and_the_drone() {
     let first = drone.slots.iter().find(|slot| slot.key.is_some()).unwrap();
     assert!((first.fundamental_hz / (0.75 * expected(50)) - 1.0).abs() < 1e-12);
 }
+
+#[test]
+fn nan_settings_neither_panic_nor_reach_the_output() {
+    // Found by the engine_events fuzz target: a NaN pluck width reached `f64::clamp` as a bound
+    // and panicked on the audio thread.
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = crate::tanpura::quality::Quality::Draft;
+    settings.pluck.width_m = f64::NAN;
+    settings.pluck.amplitude_m = f64::NAN;
+    settings.pluck.position_m = f64::NAN;
+    let mut engine = Engine::new(&settings, 44_100.0, 2);
+    let plucked = run(&mut engine, &[note_on(0, 48)], 2000);
+    assert!(plucked.iter().all(|x| x.is_finite()));
+    assert!(
+        peak(&plucked) > 0.0,
+        "the default pluck stands in for the NaN one"
+    );
+
+    // A NaN drone tempo plays at the default tempo instead of plucking at every sample.
+    settings.drone.enabled = true;
+    settings.drone.tempo_sync = false;
+    settings.drone.free_tempo_bpm = f64::NAN;
+    let mut engine = Engine::new(&settings, 44_100.0, 4);
+    let droned = run(&mut engine, &[note_on(0, 48)], 4410);
+    assert!(droned.iter().all(|x| x.is_finite()));
+    assert!(
+        engine.active_voices() <= 1,
+        "one pluck in the first 0.1 s at 60 bpm"
+    );
+
+    // A NaN glide and vibrato on the bowed string.
+    settings.drone.enabled = false;
+    settings.instrument = Instrument::Bowed;
+    settings.bowed.player.glide_time_s = f64::NAN;
+    settings.bowed.player.max_vibrato_cents = f64::NAN;
+    let mut engine = Engine::new(&settings, 44_100.0, 1);
+    let legato = [note_on(0, 60), note_on(100, 64)];
+    let bowed = run(&mut engine, &legato, 4410);
+    assert!(bowed.iter().all(|x| x.is_finite()));
+    assert!(peak(&bowed) > 0.0);
+}

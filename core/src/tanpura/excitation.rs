@@ -24,6 +24,21 @@ impl Pluck {
     /// amplitude 0–5 mm (the largest a tanpura string tolerates without hitting the neck).
     pub const WIDTH_RANGE_M: (f64, f64) = (0.002, 0.040);
     pub const AMPLITUDE_RANGE_M: (f64, f64) = (0.0, 0.005);
+
+    /// The pluck with a NaN replaced by the default's value and width and amplitude clamped to
+    /// their ranges (the position is clamped to the speaking length where the finger lands).
+    /// A NaN width would otherwise reach `f64::clamp` as a bound, which panics.
+    pub fn clamped(&self) -> Self {
+        let default = Self::default();
+        let or_default = |value: f64, fallback: f64| if value.is_nan() { fallback } else { value };
+        Self {
+            position_m: or_default(self.position_m, default.position_m),
+            width_m: or_default(self.width_m, default.width_m)
+                .clamp(Self::WIDTH_RANGE_M.0, Self::WIDTH_RANGE_M.1),
+            amplitude_m: or_default(self.amplitude_m, default.amplitude_m)
+                .clamp(Self::AMPLITUDE_RANGE_M.0, Self::AMPLITUDE_RANGE_M.1),
+        }
+    }
 }
 
 impl Default for Pluck {

@@ -501,7 +501,7 @@ impl TanpuraVoice {
 
     /// Plucks the string (and wakes it). Allocation-free.
     pub fn pluck(&mut self, pluck: &Pluck) {
-        self.string_mut().pluck(pluck);
+        self.string_mut().pluck(&pluck.clamped());
         self.sleeping = false;
         self.tail_remaining = 0;
         self.samples_since_sleep_check = 0;
