@@ -840,11 +840,15 @@ impl Engine {
         for slot in &mut self.slots {
             let mut string_settings = settings;
             string_settings.fundamental_hz = slot.fundamental_hz;
-            if slot.voice.is_active() {
-                // A voice switching tier restarts at rest (`TanpuraVoice::set_settings`), so a
-                // ringing string keeps its tier; the new one applies from its next pluck.
-                string_settings.quality = slot.voice.settings().quality;
+            if !slot.voice.is_active() {
+                // A silent string takes the settings when it is next plucked
+                // (`pluck_string`): retuning it now, every control tick of a glide, cost a
+                // static solve per silent string (the soak's deadline misses).
+                continue;
             }
+            // A voice switching tier restarts at rest (`TanpuraVoice::set_settings`), so a
+            // ringing string keeps its tier; the new one applies from its next pluck.
+            string_settings.quality = slot.voice.settings().quality;
             slot.voice.set_settings(&string_settings);
         }
     }
