@@ -29,7 +29,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use javari_core::analysis::power_spectrum;
 use javari_core::engine::bowed_stability::bowed_stability;
 use javari_core::engine::midi_file::{self, format_time, MidiScore};
-use javari_core::engine::pitch::{note_to_hz, playable_note_hz};
+use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::preset::{Preset, QUALITY_NAMES};
 use javari_core::engine::render::ScoreAction;
 use javari_core::engine::render::{render_blocks, rendered_length, RenderOptions, Score};
@@ -238,20 +238,11 @@ fn check_playable_notes(
     if settings.instrument != Instrument::Tanpura || settings.drone.enabled {
         return Ok(());
     }
-    let notes: Vec<u8> = score
-        .events
-        .iter()
-        .filter_map(|event| match event.action {
-            ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }) if velocity > 0.0 => {
-                Some(note)
-            }
-            _ => None,
-        })
-        .collect();
+    let notes = played_notes(score);
     let unplayable: Vec<u8> = notes
         .iter()
         .copied()
-        .filter(|&note| playable_note_hz(note).is_none())
+        .filter(|&note| settings.tuning.playable_note_hz(note).is_none())
         .collect();
     if unplayable.is_empty() {
         return Ok(());
@@ -265,8 +256,8 @@ fn check_playable_notes(
          outside the tanpura's range, notes 16 to 95 (20 to 2000 Hz), and are not played",
         unplayable.len(),
         notes.len(),
-        note_to_hz(lowest),
-        note_to_hz(highest)
+        settings.tuning.note_hz(lowest),
+        settings.tuning.note_hz(highest)
     );
     if unplayable.len() == notes.len() {
         return Err(format!("{source}: nothing to play: {what}"));
@@ -489,14 +480,9 @@ fn write_spectrogram(
     Ok(())
 }
 
-/// For a bowed preset: the stability margin of its Helmholtz motion (Woodhouse's analysis,
-/// `javari_core::stability::voice_link`) at every note the score plays, with the preset's bow
-/// controls; a warning for each note where it is unstable.
-fn warn_if_bowed_preset_is_unstable(settings: &EngineSettings, score: &Score) {
-    if settings.instrument != Instrument::Bowed {
-        return;
-    }
-    let mut notes: Vec<u8> = score
+/// The notes the score plays (note-ons with a velocity), in score order.
+fn played_notes(score: &Score) -> Vec<u8> {
+    score
         .events
         .iter()
         .filter_map(|event| match event.action {
@@ -505,7 +491,17 @@ fn warn_if_bowed_preset_is_unstable(settings: &EngineSettings, score: &Score) {
             }
             _ => None,
         })
-        .collect();
+        .collect()
+}
+
+/// For a bowed preset: the stability margin of its Helmholtz motion (Woodhouse's analysis,
+/// `javari_core::stability::voice_link`) at every note the score plays, with the preset's bow
+/// controls; a warning for each note where it is unstable.
+fn warn_if_bowed_preset_is_unstable(settings: &EngineSettings, score: &Score) {
+    if settings.instrument != Instrument::Bowed {
+        return;
+    }
+    let mut notes = played_notes(score);
     notes.sort_unstable();
     notes.dedup();
     for note in notes {
