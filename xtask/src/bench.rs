@@ -12,6 +12,7 @@
 //! JSON object. A benchmark, not a test: nothing here asserts on time.
 
 use crate::args::number_in;
+use crate::playing_range::{self, TierOverGrid};
 use clap::Parser;
 use javari_core::analysis::{
     band_power, cents, peak_frequency_hz, power_spectrum, spectral_centroid_hz,
@@ -42,6 +43,13 @@ pub struct BenchArgs {
     /// Also write the results as one JSON object.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// Skip the playing-range grid (the accuracy of every tier over keys, velocities and pluck
+    /// positions; its reference renders are cached under `target/bench-cache`).
+    #[arg(long, conflicts_with = "grid_only")]
+    no_grid: bool,
+    /// Only the playing-range grid, no timing scenes.
+    #[arg(long)]
+    grid_only: bool,
 }
 
 /// One measured (tier, scene) pair.
@@ -508,7 +516,7 @@ impl Scene for OneOfFour {
 }
 
 /// The issue's targets, each checked against the measured results: met, or missed by how much.
-pub fn targets_markdown(results: &[BenchResult]) -> String {
+pub fn targets_markdown(results: &[BenchResult], grid: &[TierOverGrid]) -> String {
     let find = |voice: &str, tier: &str, scene: &str| {
         results
             .iter()
@@ -579,6 +587,9 @@ pub fn targets_markdown(results: &[BenchResult]) -> String {
         false,
         " %",
     );
+    for (target, measured, goal, unit) in playing_range::target_rows(grid) {
+        line(&target, Some(measured), goal, false, unit);
+    }
     line(
         "reference tier, one string: ≥ 4× real time",
         tanpura("reference", "one-string").map(|r| r.realtime_factor),
@@ -647,7 +658,12 @@ fn json_number(value: Option<f64>) -> String {
     }
 }
 
-pub fn to_json(machine: &str, results: &[BenchResult], economy: &[EconomyRow]) -> String {
+pub fn to_json(
+    machine: &str,
+    results: &[BenchResult],
+    economy: &[EconomyRow],
+    grid: &[TierOverGrid],
+) -> String {
     let rows: Vec<String> = results
         .iter()
         .map(|r| {
@@ -683,10 +699,12 @@ pub fn to_json(machine: &str, results: &[BenchResult], economy: &[EconomyRow]) -
         })
         .collect();
     format!(
-        "{{\"machine\": \"{}\", \"results\": [\n  {}\n], \"economy\": [\n  {}\n]}}\n",
+        "{{\"machine\": \"{}\", \"results\": [\n  {}\n], \"economy\": [\n  {}\n], \
+         \"playing_range\": [\n  {}\n]}}\n",
         machine.replace('"', "'"),
         rows.join(",\n  "),
-        economy_rows.join(",\n  ")
+        economy_rows.join(",\n  "),
+        playing_range::to_json_rows(grid).join(",\n  ")
     )
 }
 
@@ -733,17 +751,42 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
         seconds,
         markdown,
         json,
+        no_grid,
+        grid_only,
     } = args;
     let machine = machine_name();
-    let results = run_all(seconds);
-    let economy = run_economy(seconds);
-    let table =
-        to_markdown(&machine, &results) + &targets_markdown(&results) + &economy_markdown(&economy);
+    // The timing scenes run first, alone: the grid renders on every core.
+    let (results, economy) = if grid_only {
+        (Vec::new(), Vec::new())
+    } else {
+        (run_all(seconds), run_economy(seconds))
+    };
+    let grid = if no_grid {
+        Vec::new()
+    } else {
+        let tiers: Vec<Quality> = Quality::ALL
+            .iter()
+            .copied()
+            .filter(|&q| q != Quality::Reference)
+            .collect();
+        playing_range::measure(&tiers, SAMPLE_RATE)
+    };
+    let mut table = String::new();
+    if !results.is_empty() {
+        table += &to_markdown(&machine, &results);
+    }
+    if !grid.is_empty() {
+        table += &playing_range::to_markdown(&grid);
+    }
+    table += &targets_markdown(&results, &grid);
+    if !economy.is_empty() {
+        table += &economy_markdown(&economy);
+    }
     print!("{table}");
     std::fs::write(&markdown, &table)
         .map_err(|error| format!("cannot write `{}`: {error}", markdown.display()))?;
     if let Some(path) = json {
-        std::fs::write(&path, to_json(&machine, &results, &economy))
+        std::fs::write(&path, to_json(&machine, &results, &economy, &grid))
             .map_err(|error| format!("cannot write `{}`: {error}", path.display()))?;
     }
     Ok(())

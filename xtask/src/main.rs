@@ -6,6 +6,7 @@
 mod args;
 mod bench;
 mod bundle;
+mod playing_range;
 mod plot;
 mod render;
 mod simulate;

@@ -1,9 +1,14 @@
 //! Signal analysis for tests, benchmarks and the offline tools: FFT, windowed spectra, precise
-//! partial frequencies, spectral centroids and band energies. Not used on the audio thread
-//! (the editor's spectrum calls [`fft`] on the GUI thread).
+//! partial frequencies, spectral centroids and band energies; [`listening`] defines what a
+//! listener compares between two renders, [`playing_range`] the grid of plucks the tiers are
+//! compared on. Not used on the audio thread (the editor's spectrum calls [`fft`] on the GUI
+//! thread).
 //!
 //! The transforms are rustfft's (complex) and realfft's (real input), planned once per length and
 //! thread and reused: these tools call them thousands of times with a handful of lengths.
+
+pub mod listening;
+pub mod playing_range;
 
 use realfft::num_complex::Complex;
 use realfft::RealFftPlanner;

@@ -1,0 +1,295 @@
+//! The bench's playing-range grid: every tier against the reference on every pluck of
+//! [`javari_core::analysis::playing_range::full_grid`] (keys 36–64, four velocities, two pluck
+//! positions), measured by [`javari_core::analysis::listening`]: worst case and median of each
+//! measure over the grid, and the worst point named.
+//!
+//! The reference renders are the expensive part (the reference tier runs near real time), so they
+//! are cached under `target/bench-cache/playing-range/`, one file per pluck (its samples as
+//! little-endian f32, exactly what the engine produced), keyed by the pluck's engine settings,
+//! the render length and rate, and the version of `core/` (its git tree, plus the hash of any
+//! uncommitted change to it). Without git the cache is not used. Renders run on all cores (rayon).
+
+use javari_core::analysis::listening::{compare, ListeningDifference};
+use javari_core::analysis::playing_range::{
+    full_grid, render, settings_for, GridPoint, NOTE_SECONDS,
+};
+use javari_core::tanpura::quality::Quality;
+use rayon::prelude::*;
+use std::collections::hash_map::DefaultHasher;
+use std::fmt::Write as _;
+use std::hash::{Hash, Hasher};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// One tier's comparison over the grid.
+#[derive(Debug, Clone)]
+pub struct TierOverGrid {
+    pub tier: &'static str,
+    pub points: Vec<(GridPoint, ListeningDifference)>,
+}
+
+/// Worst case and median of one measure over the grid, and where the worst lies.
+#[derive(Debug, Clone)]
+pub struct Spread {
+    pub worst: f64,
+    pub median: f64,
+    pub worst_at: GridPoint,
+}
+
+impl TierOverGrid {
+    fn spread(&self, measure: impl Fn(&ListeningDifference) -> f64) -> Spread {
+        let mut values: Vec<(f64, GridPoint)> = self
+            .points
+            .iter()
+            .map(|(point, difference)| (measure(difference), *point))
+            .collect();
+        values.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (worst, worst_at) = values[values.len() - 1];
+        Spread {
+            worst,
+            median: values[values.len() / 2].0,
+            worst_at,
+        }
+    }
+
+    pub fn sustained_cents(&self) -> Spread {
+        self.spread(|d| d.sustained_cents.abs())
+    }
+    pub fn glide_cents(&self) -> Spread {
+        self.spread(|d| d.glide_cents)
+    }
+    pub fn band_level_db(&self) -> Spread {
+        self.spread(|d| d.band_level_db)
+    }
+    pub fn centroid_error(&self) -> Spread {
+        self.spread(|d| d.centroid_error)
+    }
+}
+
+/// The version of `core/`: its committed tree and any uncommitted change, or `None` without git.
+fn core_version(workspace: &Path) -> Option<String> {
+    let git = |args: &[&str]| {
+        Command::new("git")
+            .args(args)
+            .current_dir(workspace)
+            .output()
+            .ok()
+            .filter(|output| output.status.success())
+            .map(|output| output.stdout)
+    };
+    let tree = git(&["rev-parse", "HEAD:core"])?;
+    let diff = git(&["diff", "HEAD", "--", "core"])?;
+    let untracked = git(&["ls-files", "--others", "--exclude-standard", "--", "core"])?;
+    let mut hasher = DefaultHasher::new();
+    diff.hash(&mut hasher);
+    untracked.hash(&mut hasher);
+    Some(format!(
+        "{}-{:016x}",
+        String::from_utf8_lossy(&tree).trim(),
+        hasher.finish()
+    ))
+}
+
+fn cache_file(directory: &Path, version: &str, point: &GridPoint, sample_rate_hz: f64) -> PathBuf {
+    let mut hasher = DefaultHasher::new();
+    version.hash(&mut hasher);
+    format!("{:?}", settings_for(Quality::Reference, point)).hash(&mut hasher);
+    point.key.hash(&mut hasher);
+    point.velocity.hash(&mut hasher);
+    NOTE_SECONDS.to_bits().hash(&mut hasher);
+    sample_rate_hz.to_bits().hash(&mut hasher);
+    directory.join(format!("{:016x}.f32", hasher.finish()))
+}
+
+fn read_cached(path: &Path, samples: usize) -> Option<Vec<f64>> {
+    let bytes = std::fs::read(path).ok()?;
+    (bytes.len() == 4 * samples).then(|| {
+        bytes
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64)
+            .collect()
+    })
+}
+
+fn write_cached(path: &Path, output: &[f64]) {
+    // The engine's output is f32, so the round trip is exact. A failed write only costs a
+    // re-render next time.
+    let bytes: Vec<u8> = output
+        .iter()
+        .flat_map(|&x| (x as f32).to_le_bytes())
+        .collect();
+    let temporary = path.with_extension("partial");
+    if std::fs::write(&temporary, bytes).is_ok() {
+        let _ = std::fs::rename(&temporary, path);
+    }
+}
+
+/// Renders (or loads) the reference over the grid and compares `tiers` with it.
+pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
+    let grid = full_grid();
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let cache = core_version(&workspace).map(|version| {
+        let directory = workspace.join("target/bench-cache/playing-range");
+        let _ = std::fs::create_dir_all(&directory);
+        (directory, version)
+    });
+    let samples = (NOTE_SECONDS * sample_rate_hz).round() as usize;
+    eprintln!(
+        "bench: playing range, {} plucks × {} tiers and the reference, on {} threads ...",
+        grid.len(),
+        tiers.len(),
+        rayon::current_num_threads()
+    );
+    // One job per (tier, pluck), the reference first so that the slowest jobs start first.
+    let mut jobs: Vec<(Option<Quality>, usize)> = (0..grid.len()).map(|i| (None, i)).collect();
+    for &tier in tiers {
+        jobs.extend((0..grid.len()).map(|i| (Some(tier), i)));
+    }
+    let renders: Vec<Vec<f64>> = jobs
+        .par_iter()
+        .map(|&(tier, index)| {
+            let point = &grid[index];
+            match tier {
+                Some(quality) => render(quality, point, NOTE_SECONDS, sample_rate_hz),
+                None => {
+                    let path = cache
+                        .as_ref()
+                        .map(|(dir, version)| cache_file(dir, version, point, sample_rate_hz));
+                    if let Some(cached) = path.as_deref().and_then(|p| read_cached(p, samples)) {
+                        return cached;
+                    }
+                    let output = render(Quality::Reference, point, NOTE_SECONDS, sample_rate_hz);
+                    if let Some(path) = path {
+                        write_cached(&path, &output);
+                    }
+                    output
+                }
+            }
+        })
+        .collect();
+    let (references, tier_renders) = renders.split_at(grid.len());
+    tiers
+        .iter()
+        .enumerate()
+        .map(|(t, quality)| {
+            let points = (0..grid.len())
+                .into_par_iter()
+                .map(|i| {
+                    let render = &tier_renders[t * grid.len() + i];
+                    let difference =
+                        compare(render, &references[i], sample_rate_hz, grid[i].nominal_hz());
+                    (grid[i], difference)
+                })
+                .collect();
+            TierOverGrid {
+                tier: quality.name(),
+                points,
+            }
+        })
+        .collect()
+}
+
+/// The grid's table: worst / median of each measure per tier, and where each worst lies.
+pub fn to_markdown(results: &[TierOverGrid]) -> String {
+    let grid = full_grid();
+    let mut text = format!(
+        "\nAcross the playing range ({} single plucks: keys 36–64 every third semitone and 64, \
+         velocities 1/40/80/127, plucks at 0.35 and 0.20 m; {:.1} s each, against the reference \
+         render of the same pluck; measures defined in `core/src/analysis/listening.rs`), worst / \
+         median over the grid:\n\n\
+         | tier | sustained pitch (0.3–1.5 s), cents | glide (first 0.3 s), cents | 1/6-octave band levels to 16 kHz, dB RMS | centroid course | worst pitch at | worst bands at |\n\
+         |---|---|---|---|---|---|---|\n",
+        grid.len(),
+        NOTE_SECONDS
+    );
+    for tier in results {
+        let (pitch, glide, bands, centroid) = (
+            tier.sustained_cents(),
+            tier.glide_cents(),
+            tier.band_level_db(),
+            tier.centroid_error(),
+        );
+        let _ = writeln!(
+            text,
+            "| {} | {:.2} / {:.2} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} % / {:.1} % | {} | {} |",
+            tier.tier,
+            pitch.worst,
+            pitch.median,
+            glide.worst,
+            glide.median,
+            bands.worst,
+            bands.median,
+            100.0 * centroid.worst,
+            100.0 * centroid.median,
+            pitch.worst_at.label(),
+            bands.worst_at.label(),
+        );
+    }
+    text
+}
+
+/// Rows for the targets table: the default and studio tiers' worst grid points against issue 15's
+/// targets (sustained pitch 1 cent, band levels 5 dB, centroid 15 %).
+pub fn target_rows(results: &[TierOverGrid]) -> Vec<(String, f64, f64, &'static str)> {
+    let mut rows = Vec::new();
+    for tier in results
+        .iter()
+        .filter(|t| t.tier == Quality::Live.name() || t.tier == Quality::Studio.name())
+    {
+        rows.push((
+            format!(
+                "{} tier, worst pluck of the range: sustained pitch within 1 cent",
+                tier.tier
+            ),
+            tier.sustained_cents().worst,
+            1.0,
+            " cents",
+        ));
+        rows.push((
+            format!(
+                "{} tier, worst pluck of the range: band levels within 5 dB RMS",
+                tier.tier
+            ),
+            tier.band_level_db().worst,
+            5.0,
+            " dB",
+        ));
+        rows.push((
+            format!(
+                "{} tier, worst pluck of the range: centroid within 15 %",
+                tier.tier
+            ),
+            100.0 * tier.centroid_error().worst,
+            15.0,
+            " %",
+        ));
+    }
+    rows
+}
+
+/// The grid as JSON rows, one per tier and pluck.
+pub fn to_json_rows(results: &[TierOverGrid]) -> Vec<String> {
+    results
+        .iter()
+        .flat_map(|tier| {
+            tier.points.iter().map(move |(point, d)| {
+                format!(
+                    "{{\"tier\": \"{}\", \"key\": {}, \"velocity\": {}, \"pluck_position_m\": {}, \
+                     \"sustained_cents\": {:.4}, \"glide_cents\": {:.4}, \"band_level_db\": {:.4}, \
+                     \"centroid_error\": {:.5}}}",
+                    tier.tier,
+                    point.key,
+                    point.velocity,
+                    point.pluck_position_m,
+                    d.sustained_cents,
+                    d.glide_cents,
+                    d.band_level_db,
+                    d.centroid_error
+                )
+            })
+        })
+        .collect()
+}
