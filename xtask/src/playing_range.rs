@@ -9,7 +9,8 @@
 //! the render length and rate, and the version of `core/` (its git tree, plus the hash of any
 //! uncommitted change to it). Without git the cache is not used. Renders run on all cores (rayon).
 
-use javari_core::analysis::listening::{compare, ListeningDifference};
+use javari_core::analysis::cents;
+use javari_core::analysis::listening::{compare, sustained_pitch_hz, ListeningDifference};
 use javari_core::analysis::playing_range::{
     full_grid, render, settings_for, GridPoint, NOTE_SECONDS,
 };
@@ -124,7 +125,9 @@ fn write_cached(path: &Path, output: &[f64]) {
     }
 }
 
-/// Renders (or loads) the reference over the grid and compares `tiers` with it.
+/// Renders (or loads) the reference over the grid and compares `tiers` with it. The first
+/// element is the reference itself against the keys' nominal pitches: its `sustained_cents` is
+/// how far the reference sounds from the note it was tuned to (the other measures are zero).
 pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
     let grid = full_grid();
     let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -171,24 +174,40 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
         })
         .collect();
     let (references, tier_renders) = renders.split_at(grid.len());
-    tiers
-        .iter()
-        .enumerate()
-        .map(|(t, quality)| {
-            let points = (0..grid.len())
-                .into_par_iter()
-                .map(|i| {
-                    let render = &tier_renders[t * grid.len() + i];
-                    let difference =
-                        compare(render, &references[i], sample_rate_hz, grid[i].nominal_hz());
-                    (grid[i], difference)
-                })
-                .collect();
-            TierOverGrid {
-                tier: quality.name(),
-                points,
-            }
-        })
+    let reference_against_nominal = TierOverGrid {
+        tier: Quality::Reference.name(),
+        points: (0..grid.len())
+            .into_par_iter()
+            .map(|i| {
+                let nominal = grid[i].nominal_hz();
+                let pitch = sustained_pitch_hz(&references[i], sample_rate_hz, nominal);
+                let difference = ListeningDifference {
+                    sustained_cents: cents(pitch, nominal),
+                    glide_cents: 0.0,
+                    band_level_db: 0.0,
+                    centroid_error: 0.0,
+                };
+                (grid[i], difference)
+            })
+            .collect(),
+    };
+    let compared = tiers.iter().enumerate().map(|(t, quality)| {
+        let points = (0..grid.len())
+            .into_par_iter()
+            .map(|i| {
+                let render = &tier_renders[t * grid.len() + i];
+                let difference =
+                    compare(render, &references[i], sample_rate_hz, grid[i].nominal_hz());
+                (grid[i], difference)
+            })
+            .collect();
+        TierOverGrid {
+            tier: quality.name(),
+            points,
+        }
+    });
+    std::iter::once(reference_against_nominal)
+        .chain(compared)
         .collect()
 }
 
@@ -205,7 +224,10 @@ pub fn to_markdown(results: &[TierOverGrid]) -> String {
         grid.len(),
         NOTE_SECONDS
     );
-    for tier in results {
+    for tier in results
+        .iter()
+        .filter(|t| t.tier != Quality::Reference.name())
+    {
         let (pitch, glide, bands, centroid) = (
             tier.sustained_cents(),
             tier.glide_cents(),
@@ -226,6 +248,18 @@ pub fn to_markdown(results: &[TierOverGrid]) -> String {
             100.0 * centroid.median,
             pitch.worst_at.label(),
             bands.worst_at.label(),
+        );
+    }
+    if let Some(reference) = results.iter().find(|t| t.tier == Quality::Reference.name()) {
+        let pitch = reference.sustained_cents();
+        let _ = writeln!(
+            text,
+            "\nThe reference itself against the keys' nominal pitches (every tier is tuned so that \
+             its string, linearised about its rest state, has the nominal pitch): its sustained \
+             pitch is off by {:.2} cents at worst ({}), {:.2} cents median.",
+            pitch.worst,
+            pitch.worst_at.label(),
+            pitch.median
         );
     }
     text

@@ -78,6 +78,13 @@ pub struct ModalStringConfig {
     pub newton: NewtonSettings,
     /// Book the losses of every step (tests and research tools; costs a pass over the modes).
     pub track_energy: bool,
+    /// Add the truncated modes' static flexibility to the static problems (section 8 of the
+    /// derivation): the rest state and the pressed shape become the continuous string's, and the
+    /// string vibrates in its kept modes about that rest state. Off (the tiers' setting): the kept
+    /// modes alone. On, the rest state and the linear pitch match the FD string's, but the
+    /// residual displacement stays frozen at its rest value while the string moves, which
+    /// distorts the contact near the crest (the formant stops falling between 0.5 and 1.5 s).
+    pub static_flexibility: bool,
 }
 
 impl ModalStringConfig {
@@ -97,6 +104,7 @@ impl ModalStringConfig {
             max_iterations: 30,
         },
         track_energy: false,
+        static_flexibility: false,
     };
 
     /// The same with all losses off (γ = η = r_b = r_c = 0).
@@ -316,7 +324,7 @@ impl<T: Real> ModalString<T> {
             config.string.left_support_m,
             config.string.length_m,
         );
-        self.points.couple(&self.modes);
+        self.points.couple(&self.modes, config.static_flexibility);
         self.lanes = self.modes.count().div_ceil(LANE_PADDING) * LANE_PADDING;
         for k in 0..MODE_CAPACITY {
             self.a[k] = T::from_f64(self.modes.a[k]);
@@ -519,12 +527,10 @@ impl<T: Real> ModalString<T> {
         self.contact.forget_corrections();
     }
 
-    /// `y_s(x) + Σ_k Ψ_k(x) c_k` for modal coefficients `c_k`, with the sines by recurrence
-    /// (no scratch, so `&self`).
-    fn shape_sum(&self, x_m: f64, coefficient: impl Fn(usize) -> f64) -> f64 {
-        let length = self.config.string.length_m;
-        let line = self.config.string.left_support_m * (1.0 - x_m / length);
-        let theta = PI * x_m / length;
+    /// `Σ_k Ψ_k(x) c_k` for modal coefficients `c_k`, with the sines by recurrence (no scratch,
+    /// so `&self`).
+    fn modal_sum(&self, x_m: f64, coefficient: impl Fn(usize) -> f64) -> f64 {
+        let theta = PI * x_m / self.config.string.length_m;
         let twice_cos = 2.0 * theta.cos();
         let (mut previous, mut current) = (0.0, theta.sin());
         let mut sum = 0.0;
@@ -534,17 +540,35 @@ impl<T: Real> ModalString<T> {
             previous = current;
             current = next;
         }
-        line + sum
+        sum
     }
 
-    /// The rest shape's displacement at `x_m`, m.
+    /// y_s(x), the line between the supports, m.
+    fn line_at_m(&self, x_m: f64) -> f64 {
+        self.config.string.left_support_m * (1.0 - x_m / self.config.string.length_m)
+    }
+
+    /// The rest shape's displacement at `x_m`, m: `y_s(x) + Σ_k Ψ_k(x) r_rest,k`, or with the
+    /// static flexibility the continuous string's `y_s(x) + Σ_i C(x, x_i) F_rest,i`.
     pub fn rest_displacement_at_m(&self, x_m: f64) -> f64 {
-        self.shape_sum(x_m, |k| self.rest_modal[k])
+        if !self.points.flexible {
+            return self.line_at_m(x_m) + self.modal_sum(x_m, |k| self.rest_modal[k]);
+        }
+        let points = &self.points;
+        let pressed: f64 = (0..points.len())
+            .filter(|&i| points.rest_forces_n[i] != 0.0)
+            .map(|i| {
+                self.modes.static_compliance_m_n(x_m, points.positions_m[i])
+                    * points.rest_forces_n[i]
+            })
+            .sum();
+        self.line_at_m(x_m) + pressed
     }
 
-    /// The string's displacement at `x_m` now, m: `y_s(x) + Σ_k Ψ_k(x) (r_rest,k + r̃_k)`.
+    /// The string's displacement at `x_m` now, m: the rest shape and the kept modes' motion
+    /// `Σ_k Ψ_k(x) r̃_k` (the step moves the string in its kept modes only).
     pub fn displacement_at_m(&self, x_m: f64) -> f64 {
-        self.shape_sum(x_m, |k| self.rest_modal[k] + self.modal[k].to_f64())
+        self.rest_displacement_at_m(x_m) + self.modal_sum(x_m, |k| self.modal[k].to_f64())
     }
 
     /// The seed's finger pluck (section 5): press the finger until the string is in static
@@ -582,6 +606,26 @@ impl<T: Real> ModalString<T> {
                 finger_height_m(x, centre, width, top) - left * (1.0 - x / length);
             self.solver.springs_n_m[row] = self.config.finger.stiffness_n_m2 * spacing;
             self.solver.forces_n[row] = 0.0;
+            // The truncated modes' compliance between this finger point and every row so far.
+            for other in 0..=row {
+                let value = if self.config.static_flexibility {
+                    let x_other = if other < count {
+                        self.points.positions_m[other]
+                    } else {
+                        centre - half_width + (other - count) as f64 * spacing
+                    };
+                    let shapes = &self.solver.shapes;
+                    self.modes.residual_compliance_m_n(
+                        x,
+                        x_other,
+                        &shapes[row * MODE_CAPACITY..(row + 1) * MODE_CAPACITY],
+                        &shapes[other * MODE_CAPACITY..(other + 1) * MODE_CAPACITY],
+                    )
+                } else {
+                    0.0
+                };
+                self.solver.set_residual(row, other, value);
+            }
         }
         self.solver.forces_n[..count].copy_from_slice(&self.points.rest_forces_n[..count]);
         let modes = self.modes.count();

@@ -30,6 +30,9 @@ pub const NYQUIST_GUARD: f64 = 0.45;
 pub struct ModeSet {
     count: usize,
     length_m: f64,
+    /// T, N, and EI, N m²: the static compliance of all the modes is closed-form in them.
+    tension_n: f64,
+    bending_stiffness_n_m2: f64,
     /// κ_k, N/m.
     pub stiffness: Vec<f64>,
     /// 1/√κ_k.
@@ -56,6 +59,8 @@ impl ModeSet {
         Self {
             count: 0,
             length_m: 1.0,
+            tension_n: 1.0,
+            bending_stiffness_n_m2: 0.0,
             stiffness: zeros(),
             inverse_root_stiffness: zeros(),
             angular_frequency: zeros(),
@@ -86,6 +91,8 @@ impl ModeSet {
         let half_length = 0.5 * length;
         let mass = string.linear_density_kg_m * half_length;
         self.length_m = length;
+        self.tension_n = string.tension_n;
+        self.bending_stiffness_n_m2 = string.bending_stiffness_n_m2;
         self.count = 0;
         for index in 0..MODE_CAPACITY {
             let number = (index + 1) as f64;
@@ -145,6 +152,56 @@ impl ModeSet {
                 *value = 0.0;
             }
         }
+    }
+}
+
+impl ModeSet {
+    /// The static compliance of the whole string (every mode, not only the kept ones) between
+    /// two points, m/N: `C(x, ξ) = Σ_k φ_k(x) φ_k(ξ)/κ_k`, the deflection at x under a unit
+    /// force at ξ, in closed form. For x ≤ ξ, with λ² = T/EI (partial fractions of
+    /// `1/(Tβ² + EIβ⁴)`):
+    ///
+    /// `C = [x (L − ξ)/L − sinh(λx) sinh(λ(L − ξ))/(λ sinh λL)] / T`,
+    ///
+    /// the second term written with decaying exponentials only,
+    /// `e^{−λ(ξ − x)} (1 − e^{−2λx})(1 − e^{−2λ(L − ξ)}) / (2λ (1 − e^{−2λL}))`, so that it
+    /// neither overflows nor cancels for the stiff strings' large λL. Without stiffness it is the
+    /// taut string's `x (L − ξ)/(L T)`.
+    pub fn static_compliance_m_n(&self, x_m: f64, xi_m: f64) -> f64 {
+        let (low, high) = if x_m <= xi_m {
+            (x_m, xi_m)
+        } else {
+            (xi_m, x_m)
+        };
+        let length = self.length_m;
+        let taut = low * (length - high) / length;
+        let bending = if self.bending_stiffness_n_m2 > 0.0 {
+            let lambda = (self.tension_n / self.bending_stiffness_n_m2).sqrt();
+            let left = -(-2.0 * lambda * low).exp_m1();
+            let right = -(-2.0 * lambda * (length - high)).exp_m1();
+            let whole = -(-2.0 * lambda * length).exp_m1();
+            (-lambda * (high - low)).exp() * left * right / (2.0 * lambda * whole)
+        } else {
+            0.0
+        };
+        (taut - bending) / self.tension_n
+    }
+
+    /// The truncated modes' part of the static compliance between two points, m/N: `C(x, ξ)`
+    /// minus the kept modes' `Σ_{k ≤ K} Ψ_k(x) Ψ_k(ξ)`, given the points' shape rows.
+    pub fn residual_compliance_m_n(
+        &self,
+        x_m: f64,
+        xi_m: f64,
+        row_x: &[f64],
+        row_xi: &[f64],
+    ) -> f64 {
+        let kept: f64 = row_x[..self.count]
+            .iter()
+            .zip(&row_xi[..self.count])
+            .map(|(a, b)| a * b)
+            .sum();
+        self.static_compliance_m_n(x_m, xi_m) - kept
     }
 }
 
@@ -284,6 +341,61 @@ mod tests {
         let b_coeff = PI * PI * p.bending_stiffness_n_m2 / (p.tension_n * 0.668 * 0.668);
         assert!((f1 - ideal * (1.0 + b_coeff).sqrt()).abs() < 1e-9);
         assert!(count > 90 && count < 120, "{count}");
+    }
+
+    /// `Σ_k φ_k(x) φ_k(ξ)/κ_k` summed over `terms` modes.
+    fn compliance_series(string: &StringParameters, x: f64, xi: f64, terms: usize) -> f64 {
+        let length = string.length_m;
+        (1..=terms)
+            .map(|k| {
+                let beta = k as f64 * PI / length;
+                let kappa = 0.5
+                    * length
+                    * (string.tension_n * beta * beta
+                        + string.bending_stiffness_n_m2 * beta.powi(4));
+                (beta * x).sin() * (beta * xi).sin() / kappa
+            })
+            .sum()
+    }
+
+    #[test]
+    fn the_closed_form_static_compliance_is_the_sum_over_all_modes() {
+        // The series converges like 1/k² (taut) or faster; two million terms leave < 1e-6.
+        let mut taut = StringParameters::SEED;
+        taut.bending_stiffness_n_m2 = 0.0;
+        for string in [StringParameters::SEED, taut] {
+            let mut modes = ModeSet::new();
+            modes.configure(&string, 1.0 / 44_100.0, AUDIBLE_LIMIT_HZ);
+            for &(x, xi) in &[(0.040, 0.0465), (0.0465, 0.040), (0.3, 0.3), (0.01, 0.6)] {
+                let closed = modes.static_compliance_m_n(x, xi);
+                let series = compliance_series(&string, x, xi, 2_000_000);
+                assert!(
+                    (closed - series).abs() < 1e-6 * closed.abs(),
+                    "x {x}, ξ {xi}: {closed:e} vs {series:e}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_residual_compliance_is_the_truncated_modes_part() {
+        let mut modes = ModeSet::new();
+        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, AUDIBLE_LIMIT_HZ);
+        let (x, xi) = (0.040, 0.0465);
+        let (mut row_x, mut row_xi) = (vec![0.0; MODE_CAPACITY], vec![0.0; MODE_CAPACITY]);
+        modes.shape_row(x, &mut row_x);
+        modes.shape_row(xi, &mut row_xi);
+        let residual = modes.residual_compliance_m_n(x, xi, &row_x, &row_xi);
+        let count = modes.count();
+        let tail = compliance_series(&StringParameters::SEED, x, xi, 2_000_000)
+            - compliance_series(&StringParameters::SEED, x, xi, count);
+        assert!(
+            (residual - tail).abs() < 1e-3 * tail.abs(),
+            "{residual:e} vs {tail:e}"
+        );
+        // At one point it is a variance: positive.
+        let own = modes.residual_compliance_m_n(x, x, &row_x, &row_x);
+        assert!(own > 0.0);
     }
 
     #[test]

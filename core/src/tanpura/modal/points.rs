@@ -6,7 +6,10 @@
 //! `w_i k` and its mid-point law scaled to newtons (`contact.rs`, [`HuntCrossley::for_point`]).
 //! For the modes it holds the shapes `Ψ_ik = φ_k(x_i)/√κ_k` and the coupling
 //! `G = Ψ diag(b) Ψᵀ` of eq. M1 (the step of point i per newton at point j, constant while the
-//! string's parameters are), and for the rest state its gaps and forces.
+//! string's parameters are), the truncated modes' static compliance `R = C − Ψ Ψᵀ` between the
+//! points (`docs/modal-tanpura.md`, section 8; `C` in closed form from `modes.rs`), and for the
+//! rest state its gaps and forces. R enters the static problems only (the rest state, the pressed
+//! finger): the step's coupling is G alone (see `docs/modal-tanpura.md` §8 for why).
 
 use super::modes::{ModeSet, MODE_CAPACITY};
 use crate::tanpura::contact::HuntCrossley;
@@ -31,6 +34,10 @@ pub struct ContactPoints {
     pub shapes: Vec<f64>,
     /// G = Ψ diag(b) Ψᵀ, `capacity × capacity`, row-major.
     pub coupling: Vec<f64>,
+    /// R = C − Ψ Ψᵀ, `capacity × capacity`, row-major; zero with the static flexibility off.
+    pub residual: Vec<f64>,
+    /// Whether R is in use (some entry non-zero).
+    pub flexible: bool,
     /// The rest state: gaps a_rest,i (m) and forces F_rest,i = w_i k ⌊a_rest,i⌋ (N).
     pub rest_gaps_m: Vec<f64>,
     pub rest_forces_n: Vec<f64>,
@@ -57,6 +64,8 @@ impl ContactPoints {
             free_gaps_m: zeros(capacity),
             shapes: zeros(capacity * MODE_CAPACITY),
             coupling: zeros(capacity * capacity),
+            residual: zeros(capacity * capacity),
+            flexible: false,
             rest_gaps_m: zeros(capacity),
             rest_forces_n: zeros(capacity),
         }
@@ -166,9 +175,15 @@ impl ContactPoints {
         self.count += 1;
     }
 
-    /// Recomputes Ψ and G for the modes (after [`ContactPoints::place`] or a change of the
-    /// string's parameters). Allocation-free; O(M K + M² K).
-    pub fn couple(&mut self, modes: &ModeSet) {
+    /// R_ij, m/N.
+    pub fn residual(&self, i: usize, j: usize) -> f64 {
+        self.residual[i * self.capacity + j]
+    }
+
+    /// Recomputes Ψ, G and (with `flexible`) R for the modes (after [`ContactPoints::place`] or
+    /// a change of the string's parameters). Allocation-free; O(M K + M² K).
+    pub fn couple(&mut self, modes: &ModeSet, flexible: bool) {
+        self.flexible = flexible;
         let count = modes.count();
         for i in 0..self.count {
             let x = self.positions_m[i];
@@ -180,12 +195,23 @@ impl ContactPoints {
         for i in 0..self.count {
             for j in 0..=i {
                 let (row_i, row_j) = (self.shape(i), self.shape(j));
-                let mut sum = 0.0;
+                // G_ij and the kept modes' static compliance in one pass.
+                let (mut sum, mut kept) = (0.0, 0.0);
                 for k in 0..count {
-                    sum += row_i[k] * modes.b[k] * row_j[k];
+                    let product = row_i[k] * row_j[k];
+                    sum += product * modes.b[k];
+                    kept += product;
                 }
+                let residual = if flexible {
+                    let (x_i, x_j) = (self.positions_m[i], self.positions_m[j]);
+                    modes.static_compliance_m_n(x_i, x_j) - kept
+                } else {
+                    0.0
+                };
                 self.coupling[i * self.capacity + j] = sum;
                 self.coupling[j * self.capacity + i] = sum;
+                self.residual[i * self.capacity + j] = residual;
+                self.residual[j * self.capacity + i] = residual;
             }
         }
     }
@@ -237,7 +263,7 @@ mod tests {
             -2e-3,
             0.668,
         );
-        points.couple(&modes);
+        points.couple(&modes, true);
         assert!(points.len() > 30);
         for i in 0..points.len() {
             assert!(points.coupling(i, i) > 0.0);

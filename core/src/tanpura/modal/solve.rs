@@ -5,13 +5,17 @@
 //! **Static problems** (rest state, pressed finger). The equilibrium minimises the convex
 //! `Π(r) = |r|²/2 + Σ_i w_i k/2 ⌊g_i − Ψ_i r⌋²`; at the minimum `r = Σ_i F_i Ψ_i`. Newton's step
 //! for the current contact set A is the exact minimiser of the quadratic model,
-//! `F_A = D (I + D G^s_AA D)⁻¹ D g_A` with `G^s = Ψ Ψᵀ` and `D = diag(√(w_i k))`; a backtracking
+//! `F_A = D (I + D G^s_AA D)⁻¹ D g_A` with `G^s = Ψ Ψᵀ + R` (R the truncated modes' static
+//! compliance, zero without the static flexibility, so that `G^s` is then the whole string's
+//! `C`) and `D = diag(√(w_i k))`; the points move by `u = Ψ r + R F` and Π gains `½ Fᵀ R F`, the
+//! truncated modes' strain energy (Π stays convex in F). A backtracking
 //! line search on Π makes it converge from any start, and it ends exactly once the contact set
 //! stops changing (the problem is piecewise quadratic).
 //!
 //! **Linearised fundamental.** The lowest eigenvalue of `(I + Ψ_Aᵀ C Ψ_A) x = ω² diag(1/ω_k²) x`
-//! (the modes with a spring at every point in contact at rest), by inverse iteration; the
-//! inverse is applied through the Woodbury identity in O(|A| K).
+//! (the modes with a spring at every point in contact at rest: the step's dynamics, which move
+//! the string in its kept modes), by inverse iteration; the inverse is applied through the
+//! Woodbury identity in O(|A| K).
 
 use super::modes::MODE_CAPACITY;
 use super::points::ContactPoints;
@@ -96,6 +100,8 @@ pub struct StaticSolver {
     capacity: usize,
     /// Ψ rows of the points, `capacity × MODE_CAPACITY`.
     pub shapes: Vec<f64>,
+    /// R between the points, `capacity × capacity` (zero without the static flexibility).
+    pub residual: Vec<f64>,
     /// g_i, m, and w_i k, N/m.
     pub free_gaps_m: Vec<f64>,
     pub springs_n_m: Vec<f64>,
@@ -128,6 +134,7 @@ impl StaticSolver {
         Self {
             capacity,
             shapes: zeros(capacity * MODE_CAPACITY),
+            residual: zeros(capacity * capacity),
             free_gaps_m: zeros(capacity),
             springs_n_m: zeros(capacity),
             forces_n: zeros(capacity),
@@ -157,16 +164,35 @@ impl StaticSolver {
             .copy_from_slice(&points.shapes[..count * MODE_CAPACITY]);
         self.free_gaps_m[..count].copy_from_slice(&points.free_gaps_m[..count]);
         self.springs_n_m[..count].copy_from_slice(&points.springs_n_m[..count]);
+        let stride = self.capacity;
+        for i in 0..count {
+            for j in 0..count {
+                self.residual[i * stride + j] = points.residual(i, j);
+            }
+        }
         count
+    }
+
+    /// R between point `i` and `j` of the loaded rows.
+    pub fn residual(&self, i: usize, j: usize) -> f64 {
+        self.residual[i * self.capacity + j]
+    }
+
+    /// Sets R between row `i` and row `j` (both ways).
+    pub fn set_residual(&mut self, i: usize, j: usize, value: f64) {
+        self.residual[i * self.capacity + j] = value;
+        self.residual[j * self.capacity + i] = value;
     }
 
     fn shape(&self, i: usize) -> &[f64] {
         &self.shapes[i * MODE_CAPACITY..(i + 1) * MODE_CAPACITY]
     }
 
-    /// r = Σ_i forces_i Ψ_i and u = Ψ r for `count` points over `modes` modes.
+    /// r = Σ_i forces_i Ψ_i and u = Ψ r + R F for `count` points over `modes` modes; `residual`
+    /// is R with row stride `stride`.
     fn modal_response(
         shapes: &[f64],
+        (residual, stride): (&[f64], usize),
         count: usize,
         modes: usize,
         forces: &[f64],
@@ -185,12 +211,39 @@ impl StaticSolver {
         }
         for i in 0..count {
             let row = &shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + modes];
-            displacements[i] = row.iter().zip(&modal[..modes]).map(|(a, b)| a * b).sum();
+            let kept: f64 = row.iter().zip(&modal[..modes]).map(|(a, b)| a * b).sum();
+            let truncated: f64 = residual[i * stride..i * stride + count]
+                .iter()
+                .zip(&forces[..count])
+                .map(|(r, f)| r * f)
+                .sum();
+            displacements[i] = kept + truncated;
         }
     }
 
-    fn energy(&self, count: usize, modes: usize, modal: &[f64], displacements: &[f64]) -> f64 {
-        let string: f64 = modal[..modes].iter().map(|r| 0.5 * r * r).sum();
+    /// Π: the kept modes' and the truncated modes' strain energy and the contact potential.
+    fn energy(
+        &self,
+        count: usize,
+        modes: usize,
+        forces: &[f64],
+        modal: &[f64],
+        displacements: &[f64],
+    ) -> f64 {
+        let stride = self.capacity;
+        let truncated: f64 = (0..count)
+            .filter(|&i| forces[i] != 0.0)
+            .map(|i| {
+                let row = &self.residual[i * stride..i * stride + count];
+                0.5 * forces[i]
+                    * row
+                        .iter()
+                        .zip(&forces[..count])
+                        .map(|(r, f)| r * f)
+                        .sum::<f64>()
+            })
+            .sum();
+        let string: f64 = modal[..modes].iter().map(|r| 0.5 * r * r).sum::<f64>() + truncated;
         let contact: f64 = (0..count)
             .map(|i| {
                 let penetration = (self.free_gaps_m[i] - displacements[i]).max(0.0);
@@ -205,13 +258,20 @@ impl StaticSolver {
     pub fn solve(&mut self, count: usize, modes: usize) -> bool {
         Self::modal_response(
             &self.shapes,
+            (&self.residual, self.capacity),
             count,
             modes,
             &self.forces_n,
             &mut self.modal,
             &mut self.displacements_m,
         );
-        let mut energy = self.energy(count, modes, &self.modal, &self.displacements_m);
+        let mut energy = self.energy(
+            count,
+            modes,
+            &self.forces_n,
+            &self.modal,
+            &self.displacements_m,
+        );
         let mut previous_size = usize::MAX;
         let mut last_step_full = false;
         for _ in 0..STATIC_MAX_ITERATIONS {
@@ -248,7 +308,7 @@ impl StaticSolver {
                         .zip(&self.shape(j)[..modes])
                         .map(|(a, b)| a * b)
                         .sum();
-                    let value = self.roots[row] * dot * self.roots[column]
+                    let value = self.roots[row] * (dot + self.residual(i, j)) * self.roots[column]
                         + if row == column { 1.0 } else { 0.0 };
                     self.matrix[row * size + column] = value;
                     self.matrix[column * size + row] = value;
@@ -278,14 +338,20 @@ impl StaticSolver {
                 }
                 Self::modal_response(
                     &self.shapes,
+                    (&self.residual, self.capacity),
                     count,
                     modes,
                     &self.blended_forces,
                     &mut self.trial_modal,
                     &mut self.trial_displacements,
                 );
-                let trial_energy =
-                    self.energy(count, modes, &self.trial_modal, &self.trial_displacements);
+                let trial_energy = self.energy(
+                    count,
+                    modes,
+                    &self.blended_forces,
+                    &self.trial_modal,
+                    &self.trial_displacements,
+                );
                 // Round-off in Π near the minimum must not reject a converging step.
                 if trial_energy <= energy + 1e-13 * energy.abs() || fraction < 1e-6 {
                     last_step_full = fraction == 1.0;
