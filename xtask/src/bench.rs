@@ -14,9 +14,8 @@
 use crate::args::number_in;
 use crate::playing_range::{self, TierOverGrid};
 use clap::Parser;
-use javari_core::analysis::{
-    band_power, cents, peak_frequency_hz, power_spectrum, spectral_centroid_hz,
-};
+use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz};
+use javari_core::analysis::{band_power, cents, peak_frequency_hz, power_spectrum};
 use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
 use javari_core::newton::NewtonStats;
@@ -294,19 +293,6 @@ fn spectral_distance_db(output: &[f64], reference: &[f64]) -> f64 {
     total / frames.max(1) as f64
 }
 
-fn formant_trajectory(output: &[f64], fundamental_hz: f64) -> Vec<f64> {
-    let bin = SAMPLE_RATE / FRAME as f64;
-    (0..output.len() / FRAME)
-        .map(|frame| {
-            let spectrum = power_spectrum(output, frame * FRAME, FRAME, FRAME);
-            if band_power(&spectrum, bin, 20.0, 20_000.0) == 0.0 {
-                return 0.0;
-            }
-            spectral_centroid_hz(&spectrum, bin, 5.5 * fundamental_hz, 15_000.0)
-        })
-        .collect()
-}
-
 fn compare_with_reference(result: &mut BenchResult, reference: &BenchResult) {
     let mine = partials(&result.output, result.fundamental_hz);
     let theirs = partials(&reference.output, reference.fundamental_hz);
@@ -317,18 +303,11 @@ fn compare_with_reference(result: &mut BenchResult, reference: &BenchResult) {
             .fold(0.0, f64::max),
     );
     result.spectral_distance_db = Some(spectral_distance_db(&result.output, &reference.output));
-    let (a, b) = (
-        formant_trajectory(&result.output, result.fundamental_hz),
-        formant_trajectory(&reference.output, reference.fundamental_hz),
-    );
-    let pairs: Vec<(f64, f64)> = a
-        .iter()
-        .zip(&b)
-        .filter(|(_, r)| **r > 0.0)
-        .map(|(x, r)| (*x, *r))
-        .collect();
-    result.formant_error =
-        Some(pairs.iter().map(|(x, r)| (x - r).abs() / r).sum::<f64>() / pairs.len().max(1) as f64);
+    // The formant measure of the playing-range grid (listening.rs), at each render's own f₀.
+    result.formant_error = Some(centroid_course_error(
+        &centroid_course_hz(&result.output, SAMPLE_RATE, result.fundamental_hz),
+        &centroid_course_hz(&reference.output, SAMPLE_RATE, reference.fundamental_hz),
+    ));
 }
 
 fn settings_at(quality: Quality) -> VoiceSettings {
