@@ -44,8 +44,10 @@
 
 use javari_core::bowed::{BowTier, BowedPlayerSettings};
 use javari_core::engine::drone::{
-    DronePattern, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE, HUMANIZE_TIMING_RANGE_S,
-    PLUCK_SPACING_RANGE_BEATS, TEMPO_RANGE_BPM,
+    DronePattern, DroneString, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE,
+    HUMANIZE_TIMING_RANGE_S, MAX_DRONE_STRINGS, PLUCK_SPACING_RANGE_BEATS,
+    STRING_FINE_TUNE_RANGE_CENTS, STRING_LEVEL_RANGE_DB, STRING_THREAD_OFFSET_RANGE_M,
+    TEMPO_RANGE_BPM,
 };
 use javari_core::engine::pitch::{Tuning, A4_HZ, A4_RANGE_HZ, FINE_TUNE_RANGE_CENTS};
 use javari_core::engine::preset::{
@@ -180,6 +182,62 @@ fn millimetres(range_m: (f64, f64)) -> FloatRange {
     }
 }
 
+/// One drone string's own fine tuning, level and thread offset (`DroneString`), shown in the
+/// host as the group "Drone string N".
+#[derive(Params)]
+pub struct DroneStringParams {
+    #[id = "stune"]
+    pub fine_tune_cents: FloatParam,
+    #[id = "slevel"]
+    pub level_db: FloatParam,
+    #[id = "sthread"]
+    pub thread_offset_mm: FloatParam,
+}
+
+impl Default for DroneStringParams {
+    fn default() -> Self {
+        Self {
+            fine_tune_cents: FloatParam::new(
+                "String fine tuning",
+                0.0,
+                FloatRange::Linear {
+                    min: STRING_FINE_TUNE_RANGE_CENTS.0 as f32,
+                    max: STRING_FINE_TUNE_RANGE_CENTS.1 as f32,
+                },
+            )
+            .with_unit(" cents")
+            .with_step_size(0.1),
+            level_db: FloatParam::new(
+                "String level",
+                0.0,
+                FloatRange::Linear {
+                    min: STRING_LEVEL_RANGE_DB.0 as f32,
+                    max: STRING_LEVEL_RANGE_DB.1 as f32,
+                },
+            )
+            .with_unit(" dB")
+            .with_step_size(0.1),
+            thread_offset_mm: FloatParam::new(
+                "String thread offset",
+                0.0,
+                millimetres(STRING_THREAD_OFFSET_RANGE_M),
+            )
+            .with_unit(" mm")
+            .with_step_size(0.01),
+        }
+    }
+}
+
+impl DroneStringParams {
+    fn settings(&self) -> DroneString {
+        DroneString {
+            fine_tune_cents: f64::from(self.fine_tune_cents.value()),
+            level_db: f64::from(self.level_db.value()),
+            thread_offset_m: f64::from(self.thread_offset_mm.value()) / MM_PER_M,
+        }
+    }
+}
+
 #[derive(Params)]
 pub struct JavariParams {
     #[id = "preset"]
@@ -234,6 +292,11 @@ pub struct JavariParams {
     pub drone_humanize_percent: FloatParam,
     #[id = "dseed"]
     pub drone_seed: IntParam,
+    #[nested(array, group = "Drone string")]
+    pub drone_strings: [DroneStringParams; MAX_DRONE_STRINGS],
+    /// Tune each string by its sustained pitch as played (measured on a background thread).
+    #[id = "asplay"]
+    pub tune_as_played: BoolParam,
     #[id = "inst"]
     pub instrument: EnumParam<InstrumentChoice>,
     #[id = "bmodel"]
@@ -429,6 +492,8 @@ impl Default for JavariParams {
             .with_unit(" %")
             .with_step_size(1.0),
             drone_seed: IntParam::new("Humanise seed", 0, IntRange::Linear { min: 0, max: 9999 }),
+            drone_strings: Default::default(),
+            tune_as_played: BoolParam::new("Tune as played", true),
             instrument: EnumParam::new("Instrument", InstrumentChoice::Tanpura),
             bow_model: EnumParam::new("Bow model", BowModelChoice::RoundedCorner),
             bowed_string: EnumParam::new("Bowed string", BowedStringChoice::ViolinA),
@@ -518,6 +583,7 @@ impl JavariParams {
             humanize_timing_s: f64::from(self.drone_humanize_ms.value()) / 1000.0,
             humanize_strength: f64::from(self.drone_humanize_percent.value()) / 100.0,
             humanize_seed: self.drone_seed.value().max(0) as u32,
+            strings: std::array::from_fn(|index| self.drone_strings[index].settings()),
         };
         let preset = match self.preset.value() {
             PresetChoice::Custom => None,
@@ -543,6 +609,7 @@ impl JavariParams {
         let tuning = Tuning {
             a4_hz: f64::from(self.reference_a4_hz.value()),
             fine_tune_cents: f64::from(self.fine_tune_cents.value()),
+            as_played: self.tune_as_played.value(),
         };
         if let Some(preset) = preset {
             let mut settings = preset.settings;

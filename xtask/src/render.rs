@@ -32,9 +32,12 @@ use javari_core::engine::midi_file::{self, format_time, MidiScore};
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::preset::{Preset, QUALITY_NAMES};
 use javari_core::engine::render::ScoreAction;
-use javari_core::engine::render::{render_blocks, rendered_length, RenderOptions, Score};
+use javari_core::engine::render::{
+    calibration_requests, render_blocks_calibrated, rendered_length, RenderOptions, Score,
+};
 use javari_core::engine::wav::read_wav;
 use javari_core::engine::{EngineEvent, EngineSettings, Instrument, VoiceRunner, VoiceTask};
+use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
 use rayon::prelude::*;
 use std::io::{BufWriter, IsTerminal};
@@ -161,16 +164,24 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         out.display()
     );
     let started = Instant::now();
+    let calibrations = calibrate(jobs, &settings, &score, sample_rate_hz)?;
     let mut progress = Progress::new(total, sample_rate_hz);
     let mut wav = PendingWav::create(&out, sample_rate_hz)?;
     let mut peak = 0.0f32;
     let mut written = 0usize;
-    render_on(jobs, &settings, &score, &options, &mut |block| {
-        peak = block.iter().fold(peak, |peak, x| peak.max(x.abs()));
-        written += block.len();
-        progress.update(written);
-        wav.write(block)
-    })?;
+    render_on(
+        jobs,
+        &settings,
+        &calibrations,
+        &score,
+        &options,
+        &mut |block| {
+            peak = block.iter().fold(peak, |peak, x| peak.max(x.abs()));
+            written += block.len();
+            progress.update(written);
+            wav.write(block)
+        },
+    )?;
     progress.finish();
     if peak == 0.0 {
         return Err(format!(
@@ -412,12 +423,13 @@ fn progress_line(
 fn render_on(
     jobs: usize,
     settings: &EngineSettings,
+    calibrations: &[Calibration],
     score: &Score,
     options: &RenderOptions,
     emit: &mut (dyn FnMut(&[f32]) -> Result<(), String> + Send),
 ) -> Result<(), String> {
     if jobs <= 1 {
-        return render_blocks(settings, score, options, None, emit);
+        return render_blocks_calibrated(settings, calibrations, score, options, None, emit);
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
@@ -428,8 +440,46 @@ fn render_on(
     pool.install(|| {
         let runner = |tasks: &mut [VoiceTask<'_>]| tasks.par_iter_mut().for_each(VoiceTask::run);
         let runner: VoiceRunner<'_> = &runner;
-        render_blocks(settings, score, options, Some(runner), emit)
+        render_blocks_calibrated(settings, calibrations, score, options, Some(runner), emit)
     })
+}
+
+/// Tunes every string the score plucks by its sustained pitch as played
+/// (`javari_core::tanpura::as_played`): each string is measured on `jobs` threads (rayon) and
+/// announced with the time it took. None when the preset turns the as-played tuning off.
+fn calibrate(
+    jobs: usize,
+    settings: &EngineSettings,
+    score: &Score,
+    sample_rate_hz: f64,
+) -> Result<Vec<Calibration>, String> {
+    let requests = calibration_requests(settings, score);
+    if requests.is_empty() {
+        return Ok(Vec::new());
+    }
+    let started = Instant::now();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+        .map_err(|error| format!("cannot start {jobs} threads: {error}"))?;
+    let calibrations: Vec<Calibration> = pool.install(|| {
+        requests
+            .par_iter()
+            .map(|request| Calibration::measure(request, sample_rate_hz))
+            .collect()
+    });
+    let largest = calibrations
+        .iter()
+        .map(|calibration| calibration.offset_cents.abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "tuned {} string{} by their sustained pitch as played in {:.1} s (largest offset from \
+         the linearised tuning {largest:.1} cents)",
+        calibrations.len(),
+        if calibrations.len() == 1 { "" } else { "s" },
+        started.elapsed().as_secs_f64()
+    );
+    Ok(calibrations)
 }
 
 /// Frame length and hop of the spectrogram, samples.
@@ -540,12 +590,22 @@ mod tests {
             block_size: 256,
             ..RenderOptions::default()
         };
+        // Tuned as played, as `render` does.
+        let calibrations = calibrate(2, &settings, &score, options.sample_rate_hz).unwrap();
+        assert!(!calibrations.is_empty());
         let bits = |jobs| {
             let mut bits = Vec::new();
-            render_on(jobs, &settings, &score, &options, &mut |block| {
-                bits.extend(block.iter().map(|x| x.to_bits()));
-                Ok(())
-            })
+            render_on(
+                jobs,
+                &settings,
+                &calibrations,
+                &score,
+                &options,
+                &mut |block| {
+                    bits.extend(block.iter().map(|x| x.to_bits()));
+                    Ok(())
+                },
+            )
             .unwrap();
             bits
         };

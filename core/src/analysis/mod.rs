@@ -75,16 +75,24 @@ pub fn windowed_dft_power<T: Copy + Into<f64>>(
     frequency_hz: f64,
 ) -> f64 {
     let n = signal.len();
+    let windowed: Vec<f64> = signal
+        .iter()
+        .zip(hann(n))
+        .map(|(&sample, weight)| sample.into() * weight)
+        .collect();
+    dft_power(&windowed, sample_rate_hz, frequency_hz)
+}
+
+/// |DFT|² of an already windowed `signal` at `frequency_hz` (any frequency, not only a bin).
+fn dft_power(windowed: &[f64], sample_rate_hz: f64, frequency_hz: f64) -> f64 {
     let omega = 2.0 * PI * frequency_hz / sample_rate_hz;
     let (mut re, mut im) = (0.0, 0.0);
     // Rotate a phasor instead of calling sin/cos per sample; renormalise to stop drift.
     let (step_sin, step_cos) = omega.sin_cos();
     let (mut c, mut s) = (1.0f64, 0.0f64);
-    for (i, &sample) in signal.iter().enumerate() {
-        let x: f64 = sample.into();
-        let w = 0.5 - 0.5 * (2.0 * PI * i as f64 / n as f64).cos();
-        re += x * w * c;
-        im -= x * w * s;
+    for (i, &x) in windowed.iter().enumerate() {
+        re += x * c;
+        im -= x * s;
         let next_c = c * step_cos - s * step_sin;
         s = s * step_cos + c * step_sin;
         c = next_c;
@@ -97,16 +105,20 @@ pub fn windowed_dft_power<T: Copy + Into<f64>>(
     re * re + im * im
 }
 
-/// The frequency of the strongest spectral peak within `[low_hz, high_hz]`, refined by
-/// golden-section search on the windowed DFT to well under a millihertz for second-long signals.
 pub fn peak_frequency_hz(signal: &[f64], sample_rate_hz: f64, low_hz: f64, high_hz: f64) -> f64 {
     let duration = signal.len() as f64 / sample_rate_hz;
+    let n = signal.len();
+    let windowed: Vec<f64> = signal
+        .iter()
+        .zip(hann(n))
+        .map(|(&sample, weight)| sample * weight)
+        .collect();
     // Coarse scan at a quarter of the window's resolution.
     let step = 0.25 / duration;
     let mut best = (low_hz, -1.0);
     let mut f = low_hz;
     while f <= high_hz {
-        let power = windowed_dft_power(signal, sample_rate_hz, f);
+        let power = dft_power(&windowed, sample_rate_hz, f);
         if power > best.1 {
             best = (f, power);
         }
@@ -116,21 +128,21 @@ pub fn peak_frequency_hz(signal: &[f64], sample_rate_hz: f64, low_hz: f64, high_
     let ratio = (5.0f64.sqrt() - 1.0) / 2.0;
     let mut x1 = b - ratio * (b - a);
     let mut x2 = a + ratio * (b - a);
-    let mut p1 = windowed_dft_power(signal, sample_rate_hz, x1);
-    let mut p2 = windowed_dft_power(signal, sample_rate_hz, x2);
+    let mut p1 = dft_power(&windowed, sample_rate_hz, x1);
+    let mut p2 = dft_power(&windowed, sample_rate_hz, x2);
     for _ in 0..60 {
         if p1 > p2 {
             b = x2;
             x2 = x1;
             p2 = p1;
             x1 = b - ratio * (b - a);
-            p1 = windowed_dft_power(signal, sample_rate_hz, x1);
+            p1 = dft_power(&windowed, sample_rate_hz, x1);
         } else {
             a = x1;
             x1 = x2;
             p1 = p2;
             x2 = a + ratio * (b - a);
-            p2 = windowed_dft_power(signal, sample_rate_hz, x2);
+            p2 = dft_power(&windowed, sample_rate_hz, x2);
         }
         if b - a < 1e-7 {
             break;

@@ -14,6 +14,11 @@
 //! 1, 1, 1 and 2 beats). The beat follows the host's tempo when tempo sync is on (or a free
 //! tempo otherwise).
 //!
+//! **Each string apart** ([`DroneString`]): players tune each string by ear and adjust each
+//! string's jawari (the thread under it) apart, and balance the strings' levels. Each string has
+//! a fine tuning (±50 cents on top of its interval), a level (dB, −60 to +6) and an offset of its
+//! thread from the instrument's thread position (±5 mm; the sum stays within the thread's range).
+//!
 //! **Humanisation.** Each pluck may come early or late by up to
 //! [`DroneSettings::humanize_timing_s`] and be softer by up to
 //! [`DroneSettings::humanize_strength`] (a fraction of the full pluck), drawn from a SplitMix64
@@ -37,6 +42,43 @@ pub const CYCLE_PAUSE_RANGE_BEATS: (f64, f64) = (0.0, 8.0);
 /// Valid humanisation: timing spread (s) and strength spread (fraction of the pluck).
 pub const HUMANIZE_TIMING_RANGE_S: (f64, f64) = (0.0, 0.05);
 pub const HUMANIZE_STRENGTH_RANGE: (f64, f64) = (0.0, 0.5);
+
+/// Valid per-string fine tuning (cents), level (dB) and thread offset (m).
+pub const STRING_FINE_TUNE_RANGE_CENTS: (f64, f64) = (-50.0, 50.0);
+pub const STRING_LEVEL_RANGE_DB: (f64, f64) = (-60.0, 6.0);
+pub const STRING_THREAD_OFFSET_RANGE_M: (f64, f64) = (-0.005, 0.005);
+
+/// What a player sets on one drone string apart from the others.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DroneString {
+    /// Fine tuning on top of the string's interval, cents (±50).
+    pub fine_tune_cents: f64,
+    /// Level, dB (−60 to +6; 0: as plucked).
+    pub level_db: f64,
+    /// The thread's offset from the instrument's thread position, m (±0.005).
+    pub thread_offset_m: f64,
+}
+
+impl DroneString {
+    /// Every number within its range; NaN takes 0.
+    pub fn clamped(&self) -> Self {
+        Self {
+            fine_tune_cents: within(self.fine_tune_cents, STRING_FINE_TUNE_RANGE_CENTS, 0.0),
+            level_db: within(self.level_db, STRING_LEVEL_RANGE_DB, 0.0),
+            thread_offset_m: within(self.thread_offset_m, STRING_THREAD_OFFSET_RANGE_M, 0.0),
+        }
+    }
+
+    /// The level as an amplitude factor.
+    pub fn level_factor(&self) -> f64 {
+        10f64.powf(self.level_db / 20.0)
+    }
+
+    /// The pitch ratio of the fine tuning.
+    pub fn fine_tune_ratio(&self) -> f64 {
+        (self.fine_tune_cents / 1200.0).exp2()
+    }
+}
 
 /// How many strings the drone has and what they play.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -83,6 +125,8 @@ pub struct DroneSettings {
     /// Largest softening of a pluck, fraction of the full pluck (0–0.5).
     pub humanize_strength: f64,
     pub humanize_seed: u32,
+    /// Each string's fine tuning, level and thread, in playing order.
+    pub strings: [DroneString; MAX_DRONE_STRINGS],
 }
 
 impl Default for DroneSettings {
@@ -98,6 +142,7 @@ impl Default for DroneSettings {
             humanize_timing_s: 0.0,
             humanize_strength: 0.0,
             humanize_seed: 0,
+            strings: [DroneString::default(); MAX_DRONE_STRINGS],
         }
     }
 }

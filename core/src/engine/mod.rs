@@ -39,6 +39,7 @@ pub mod smoothing;
 pub mod wav;
 
 use crate::bowed::{BowedEvent, BowedInstrument, BowedPlayerSettings, StringConstants};
+use crate::tanpura::as_played::{AsPlayedTuning, Calibration, CalibrationRequest, NOTE_VELOCITIES};
 use crate::tanpura::body::{Body, TANPURA_BODY};
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
@@ -238,6 +239,7 @@ impl EngineSettings {
                     drone::HUMANIZE_STRENGTH_RANGE,
                     default.drone.humanize_strength,
                 ),
+                strings: self.drone.strings.map(|string| string.clamped()),
                 ..self.drone
             },
             instrument: self.instrument,
@@ -249,6 +251,7 @@ impl EngineSettings {
                     pitch::FINE_TUNE_RANGE_CENTS,
                     default.tuning.fine_tune_cents,
                 ),
+                as_played: self.tuning.as_played,
             },
             bowed: BowedEngineSettings {
                 player: BowedPlayerSettings {
@@ -365,7 +368,10 @@ enum StringKey {
 struct Slot {
     voice: TanpuraVoice,
     key: Option<StringKey>,
+    /// The note the string sounds (its key's pitch).
     fundamental_hz: f64,
+    /// What its linearised tuning aims at: the note moved by its as-played offset.
+    tuned_hz: f64,
     /// Output scaling that keeps the level independent of pitch (see [`pitch_level_factor`]).
     level_factor: f64,
     /// Absolute sample of the last pluck.
@@ -432,6 +438,12 @@ pub fn pitch_level_factor(fundamental_hz: f64) -> f64 {
     ratio * ratio
 }
 
+/// The soft and firm ends of a drone string's plucks (fractions of full): full strength, less
+/// the humanisation's largest softening.
+fn drone_velocities(drone: &DroneSettings) -> [f64; 2] {
+    [1.0 - drone.humanize_strength, 1.0]
+}
+
 /// The polyphonic tanpura engine.
 #[derive(Debug, Clone)]
 pub struct Engine {
@@ -460,7 +472,15 @@ pub struct Engine {
     scratch: Vec<Vec<f32>>,
     /// The tanpura's body, between the strings' total bridge force and the output.
     body: Body,
+    /// Each string's tuning by its sustained pitch as played (`tanpura/as_played.rs`).
+    as_played: AsPlayedTuning,
+    /// Strings plucked without a current calibration, for the host to measure off the audio
+    /// thread ([`Engine::take_wanted_calibration`]).
+    wanted: [Option<CalibrationRequest>; WANTED_CAPACITY],
 }
+
+/// Calibration requests an engine keeps until they are taken.
+const WANTED_CAPACITY: usize = 8;
 
 /// `ln(1 + k_b)`: stiffness ramps in a logarithmic domain (its range spans twelve decades) that
 /// still contains 0.
@@ -486,6 +506,7 @@ impl Engine {
                 voice: TanpuraVoice::new(&voice, sample_rate_hz),
                 key: None,
                 fundamental_hz: voice.fundamental_hz,
+                tuned_hz: voice.fundamental_hz,
                 level_factor: 1.0,
                 plucked_at: 0,
                 level: 0.0,
@@ -527,6 +548,8 @@ impl Engine {
             applied_bow_controls: None,
             scratch: Vec::new(),
             body: Body::new(&TANPURA_BODY, sample_rate_hz),
+            as_played: AsPlayedTuning::default(),
+            wanted: [None; WANTED_CAPACITY],
         };
         engine.apply_bowed_settings();
         engine
@@ -649,6 +672,69 @@ impl Engine {
                 .voice
                 .latency_samples_at(self.target.voice.quality),
         }
+    }
+
+    /// Adds a string's as-played calibration (measured off the audio thread with
+    /// [`Calibration::measure`]); it applies from that string's next pluck. Allocation-free.
+    pub fn set_calibration(&mut self, calibration: &Calibration) {
+        self.as_played.insert(*calibration);
+    }
+
+    /// The calibrations the engine tunes with.
+    pub fn as_played_tuning(&self) -> &AsPlayedTuning {
+        &self.as_played
+    }
+
+    /// A string that was plucked without a current calibration: the host measures it off the audio thread and hands it
+    /// back through [`Engine::set_calibration`]. Allocation-free.
+    pub fn take_wanted_calibration(&mut self) -> Option<CalibrationRequest> {
+        self.wanted.iter_mut().find_map(Option::take)
+    }
+
+    /// The settings of every string that a score of `notes` (note numbers, in any order, repeats
+    /// allowed) plucks with these settings: each note's string, or in drone mode each string of
+    /// the drone on each note as Sa. What an offline renderer calibrates before it renders
+    /// (before glides: the targets' settings). Allocates.
+    pub fn planned_strings(settings: &EngineSettings, notes: &[u8]) -> Vec<CalibrationRequest> {
+        let settings = settings.clamped();
+        let mut strings: Vec<CalibrationRequest> = Vec::new();
+        let mut add = |fundamental_hz: f64, thread_offset_m: f64, velocities: [f64; 2]| {
+            let (low, high) = VoiceSettings::FUNDAMENTAL_RANGE_HZ;
+            if !(low..=high).contains(&fundamental_hz) {
+                return;
+            }
+            let mut voice = settings.voice;
+            voice.fundamental_hz = fundamental_hz;
+            voice.thread_position_m += thread_offset_m;
+            if settings.tanpura_output == TanpuraOutput::Radiated {
+                voice.nut_pickup_weight = 0.0;
+            }
+            let request = CalibrationRequest {
+                settings: voice.clamped(),
+                pluck: settings.pluck.clamped(),
+                velocities,
+            };
+            if !strings.contains(&request) {
+                strings.push(request);
+            }
+        };
+        for &note in notes {
+            let hz = settings.tuning.note_hz(note);
+            if settings.drone.enabled {
+                let drone = settings.drone;
+                let (ratios, count) = string_ratios(drone.first_string, drone.pattern);
+                for (ratio, string) in ratios.iter().zip(&drone.strings).take(count) {
+                    add(
+                        hz * ratio * string.fine_tune_ratio(),
+                        string.thread_offset_m,
+                        drone_velocities(&drone),
+                    );
+                }
+            } else {
+                add(hz, 0.0, NOTE_VELOCITIES);
+            }
+        }
+        strings
     }
 
     /// The host's tempo for the drone, beats per minute (None when the host reports none).
@@ -833,13 +919,25 @@ impl Engine {
             settings.nut_pickup_weight = 0.0;
         }
         settings.fundamental_hz = self.current_voice.fundamental_hz;
+        let drone_strings = self.target.drone.strings;
+        for slot in &mut self.slots {
+            if let Some(StringKey::Drone(index)) = slot.key {
+                // A drone string's level follows its setting while it rings.
+                slot.level_factor =
+                    pitch_level_factor(slot.fundamental_hz) * drone_strings[index].level_factor();
+            }
+        }
         if settings == self.current_voice {
             return;
         }
         self.current_voice = settings;
         for slot in &mut self.slots {
             let mut string_settings = settings;
-            string_settings.fundamental_hz = slot.fundamental_hz;
+            string_settings.fundamental_hz = slot.tuned_hz;
+            if let Some(StringKey::Drone(index)) = slot.key {
+                string_settings.thread_position_m += drone_strings[index].thread_offset_m;
+            }
+            let mut string_settings = string_settings.clamped();
             if !slot.voice.is_active() {
                 // A silent string takes the settings when it is next plucked
                 // (`pluck_string`): retuning it now, every control tick of a glide, cost a
@@ -934,7 +1032,9 @@ impl Engine {
             return;
         };
         let (ratios, _) = string_ratios(drone.first_string, drone.pattern);
-        let hz = self.target.tuning.note_hz(sa_note) * ratios[pluck.string];
+        let hz = self.target.tuning.note_hz(sa_note)
+            * ratios[pluck.string]
+            * drone.strings[pluck.string].fine_tune_ratio();
         let (low, high) = VoiceSettings::FUNDAMENTAL_RANGE_HZ;
         if (low..=high).contains(&hz) {
             self.pluck_string(StringKey::Drone(pluck.string), hz, pluck.strength as f32);
@@ -973,18 +1073,59 @@ impl Engine {
             .map_or(0, |(index, _)| index)
     }
 
+    /// The settings of the string that plays `key` at `fundamental_hz` now (before its
+    /// as-played offset): the smoothed shared settings, the note, and a drone string's thread.
+    fn string_settings(&self, key: StringKey, fundamental_hz: f64) -> VoiceSettings {
+        let mut settings = self.current_voice;
+        settings.fundamental_hz = fundamental_hz;
+        if let StringKey::Drone(index) = key {
+            settings.thread_position_m += self.target.drone.strings[index].thread_offset_m;
+        }
+        settings.clamped()
+    }
+
+    /// Remembers a string without a current calibration, for the host.
+    fn want_calibration(&mut self, request: &CalibrationRequest) {
+        if self.wanted.iter().flatten().any(|wanted| wanted == request) {
+            return;
+        }
+        if let Some(free) = self.wanted.iter_mut().find(|wanted| wanted.is_none()) {
+            *free = Some(*request);
+        }
+    }
+
     fn pluck_string(&mut self, key: StringKey, fundamental_hz: f64, velocity: f32) {
         let index = self.choose_voice(key, fundamental_hz);
+        let mut string_settings = self.string_settings(key, fundamental_hz);
+        if self.target.tuning.as_played {
+            let velocities = match key {
+                StringKey::Drone(_) => drone_velocities(&self.target.drone),
+                StringKey::Note(_) => NOTE_VELOCITIES,
+            };
+            let request = CalibrationRequest {
+                settings: string_settings,
+                pluck: self.target.pluck.clamped(),
+                velocities,
+            };
+            if !self.as_played.is_current(&request, self.sample_rate_hz) {
+                self.want_calibration(&request);
+            }
+            let offset = self.as_played.offset_cents(&string_settings);
+            string_settings.fundamental_hz *= (offset / 1200.0).exp2();
+        }
+        let level = match key {
+            StringKey::Drone(string) => self.target.drone.strings[string].level_factor(),
+            StringKey::Note(_) => 1.0,
+        };
         let slot = &mut self.slots[index];
-        let mut string_settings = self.current_voice;
-        string_settings.fundamental_hz = fundamental_hz;
         if slot.key != Some(key) || slot.fundamental_hz != fundamental_hz {
             // A stolen string is stopped first: its old vibration belongs to another tuning.
             slot.voice.reset();
             slot.key = Some(key);
             slot.fundamental_hz = fundamental_hz;
-            slot.level_factor = pitch_level_factor(fundamental_hz);
         }
+        slot.tuned_hz = string_settings.fundamental_hz;
+        slot.level_factor = pitch_level_factor(fundamental_hz) * level;
         // Also brings a re-plucked string to the current quality tier.
         slot.voice.set_settings(&string_settings);
         let mut pluck = self.target.pluck;

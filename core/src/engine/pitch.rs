@@ -22,6 +22,9 @@ pub const FINE_TUNE_RANGE_CENTS: (f64, f64) = (-100.0, 100.0);
 pub struct Tuning {
     pub a4_hz: f64,
     pub fine_tune_cents: f64,
+    /// Tune each string by its sustained pitch as played (`tanpura/as_played.rs`) where a
+    /// calibration is at hand; off: by its small-amplitude linearisation only.
+    pub as_played: bool,
 }
 
 impl Default for Tuning {
@@ -29,6 +32,7 @@ impl Default for Tuning {
         Self {
             a4_hz: A4_HZ,
             fine_tune_cents: 0.0,
+            as_played: true,
         }
     }
 }
@@ -101,6 +105,7 @@ mod tests {
         let baroque = Tuning {
             a4_hz: 415.0,
             fine_tune_cents: 0.0,
+            as_played: true,
         };
         assert_eq!(baroque.note_hz(69), 415.0);
         // 415 Hz is 101.4 cents below 440 Hz, for every note.
@@ -109,12 +114,14 @@ mod tests {
         let raised = Tuning {
             a4_hz: 440.0,
             fine_tune_cents: 37.0,
+            as_played: true,
         };
         assert!((cents(raised.note_hz(50), note_to_hz(50)) - 37.0).abs() < 1e-9);
         assert_eq!(Tuning::default().note_hz(60), note_to_hz(60));
         let wild = Tuning {
             a4_hz: f64::NAN,
             fine_tune_cents: 1e9,
+            as_played: true,
         };
         assert!((cents(wild.note_hz(60), note_to_hz(60)) - 100.0).abs() < 1e-9);
     }

@@ -36,6 +36,10 @@
 //! | `drone_humanize_timing_s` | s | 0–0.05 | largest timing displacement of a pluck |
 //! | `drone_humanize_strength` | 1 | 0–0.5 | largest softening of a pluck |
 //! | `drone_humanize_seed` | 1 | 0–4294967295 | the humanisation's seed (whole number) |
+//! | `drone_string_fine_tune_cents` | cents | up to 6 of −50–50 | each drone string's fine tuning, in playing order (missing strings: 0) |
+//! | `drone_string_level_db` | dB | up to 6 of −60–6 | each drone string's level |
+//! | `drone_string_thread_offset_m` | m | up to 6 of −0.005–0.005 | each drone string's thread, from `thread_position_m` |
+//! | `tune_as_played` | bool | | tune each string by its sustained pitch as played (`tanpura/as_played.rs`) |
 //! | `instrument` | text | tanpura, bowed | which instrument plays |
 //! | `bow_model` | text | rounded-corner, bow-table | the bowed tier |
 //! | `bow_string` | text | violin-a, cello-d | the bowed string's constants |
@@ -48,7 +52,8 @@
 
 use super::drone::{
     DronePattern, CYCLE_PAUSE_RANGE_BEATS, HUMANIZE_STRENGTH_RANGE, HUMANIZE_TIMING_RANGE_S,
-    PLUCK_SPACING_RANGE_BEATS, TEMPO_RANGE_BPM,
+    MAX_DRONE_STRINGS, PLUCK_SPACING_RANGE_BEATS, STRING_FINE_TUNE_RANGE_CENTS,
+    STRING_LEVEL_RANGE_DB, STRING_THREAD_OFFSET_RANGE_M, TEMPO_RANGE_BPM,
 };
 use super::pitch::{A4_RANGE_HZ, FINE_TUNE_RANGE_CENTS};
 use super::{BowedStringKind, EngineSettings, Instrument, TanpuraOutput, OUTPUT_GAIN_RANGE_DB};
@@ -137,6 +142,8 @@ enum Kind {
     Number((f64, f64)),
     /// One of a few quoted words.
     Choice(&'static [&'static str]),
+    /// A list of up to [`MAX_DRONE_STRINGS`] numbers, each within an inclusive range.
+    Numbers((f64, f64)),
 }
 
 impl Kind {
@@ -146,12 +153,15 @@ impl Kind {
             Kind::Switch => "true or false".to_string(),
             Kind::Number((min, max)) => format!("a number from {min} to {max}"),
             Kind::Choice(choices) => format!("one of \"{}\"", choices.join("\", \"")),
+            Kind::Numbers((min, max)) => {
+                format!("a list of up to {MAX_DRONE_STRINGS} numbers from {min} to {max}")
+            }
         }
     }
 }
 
 /// Every key and what it takes, in the order of [`PresetFile`] and of the table above.
-const KEYS: [(&str, Kind); 35] = [
+const KEYS: [(&str, Kind); 39] = [
     ("name", Kind::Text),
     (
         "bridge_stiffness_n_m2",
@@ -196,6 +206,19 @@ const KEYS: [(&str, Kind); 35] = [
         Kind::Number(HUMANIZE_STRENGTH_RANGE),
     ),
     ("drone_humanize_seed", Kind::Number((0.0, 4_294_967_295.0))),
+    (
+        "drone_string_fine_tune_cents",
+        Kind::Numbers(STRING_FINE_TUNE_RANGE_CENTS),
+    ),
+    (
+        "drone_string_level_db",
+        Kind::Numbers(STRING_LEVEL_RANGE_DB),
+    ),
+    (
+        "drone_string_thread_offset_m",
+        Kind::Numbers(STRING_THREAD_OFFSET_RANGE_M),
+    ),
+    ("tune_as_played", Kind::Switch),
     ("instrument", Kind::Choice(&INSTRUMENT_NAMES)),
     ("bow_model", Kind::Choice(&BOW_MODEL_NAMES)),
     ("bow_string", Kind::Choice(&BOW_STRING_NAMES)),
@@ -244,6 +267,10 @@ struct PresetFile {
     drone_humanize_timing_s: Option<Spanned<f64>>,
     drone_humanize_strength: Option<Spanned<f64>>,
     drone_humanize_seed: Option<Spanned<f64>>,
+    drone_string_fine_tune_cents: Option<Spanned<Vec<f64>>>,
+    drone_string_level_db: Option<Spanned<Vec<f64>>>,
+    drone_string_thread_offset_m: Option<Spanned<Vec<f64>>>,
+    tune_as_played: Option<Spanned<bool>>,
     instrument: Option<Spanned<String>>,
     bow_model: Option<Spanned<String>>,
     bow_string: Option<Spanned<String>>,
@@ -315,6 +342,25 @@ impl Checker<'_> {
             return Err(self.fail(key, value.span()));
         }
         Ok(Some(number))
+    }
+
+    /// A list of numbers, each in its range, at most one per drone string.
+    fn numbers(
+        &self,
+        key: &str,
+        value: Option<Spanned<Vec<f64>>>,
+    ) -> Result<Option<Vec<f64>>, PresetError> {
+        let Some(value) = value else { return Ok(None) };
+        let Some(Kind::Numbers((min, max))) = kind_of(key) else {
+            unreachable!("`{key}` is a list of numbers in KEYS")
+        };
+        let numbers = value.get_ref();
+        if numbers.len() > MAX_DRONE_STRINGS
+            || !numbers.iter().all(|&number| min <= number && number <= max)
+        {
+            return Err(self.fail(key, value.span()));
+        }
+        Ok(Some(numbers.clone()))
     }
 
     fn choice(
@@ -512,6 +558,38 @@ impl Preset {
             &mut settings.drone.humanize_strength,
             check.number("drone_humanize_strength", read.drone_humanize_strength)?,
         );
+        let strings = &mut settings.drone.strings;
+        for (index, value) in check
+            .numbers(
+                "drone_string_fine_tune_cents",
+                read.drone_string_fine_tune_cents,
+            )?
+            .unwrap_or_default()
+            .into_iter()
+            .enumerate()
+        {
+            strings[index].fine_tune_cents = value;
+        }
+        for (index, value) in check
+            .numbers("drone_string_level_db", read.drone_string_level_db)?
+            .unwrap_or_default()
+            .into_iter()
+            .enumerate()
+        {
+            strings[index].level_db = value;
+        }
+        for (index, value) in check
+            .numbers(
+                "drone_string_thread_offset_m",
+                read.drone_string_thread_offset_m,
+            )?
+            .unwrap_or_default()
+            .into_iter()
+            .enumerate()
+        {
+            strings[index].thread_offset_m = value;
+        }
+        set_switch(&mut settings.tuning.as_played, switch(read.tune_as_played));
         if let Some(seed) = check.number("drone_humanize_seed", read.drone_humanize_seed)? {
             // In range, so the conversion only drops a fraction.
             settings.drone.humanize_seed = seed as u32;
@@ -566,6 +644,7 @@ impl Preset {
         let v = &s.voice;
         let value = |value| Some(Spanned::new(0..0, value));
         let text = |text: &str| Some(Spanned::new(0..0, text.to_string()));
+        let list = |values: [f64; MAX_DRONE_STRINGS]| Some(Spanned::new(0..0, values.to_vec()));
         let file = PresetFile {
             name: text(&self.name),
             bridge_stiffness_n_m2: value(v.bridge_stiffness_n_m2),
@@ -593,6 +672,14 @@ impl Preset {
             drone_humanize_timing_s: value(s.drone.humanize_timing_s),
             drone_humanize_strength: value(s.drone.humanize_strength),
             drone_humanize_seed: value(f64::from(s.drone.humanize_seed)),
+            drone_string_fine_tune_cents: list(
+                s.drone.strings.map(|string| string.fine_tune_cents),
+            ),
+            drone_string_level_db: list(s.drone.strings.map(|string| string.level_db)),
+            drone_string_thread_offset_m: list(
+                s.drone.strings.map(|string| string.thread_offset_m),
+            ),
+            tune_as_played: Some(Spanned::new(0..0, s.tuning.as_played)),
             instrument: text(INSTRUMENT_NAMES[s.instrument as usize]),
             bow_model: text(BOW_MODEL_NAMES[s.bowed.player.tier as usize]),
             bow_string: text(BOW_STRING_NAMES[s.bowed.string as usize]),

@@ -2,7 +2,8 @@
 //! exactly as a host would drive the plugin. `cargo xtask render` and the tests/ crate both call
 //! [`render`], so what they check is what users hear.
 
-use super::{Engine, EngineEvent, EngineSettings, TimedEvent, VoiceRunner};
+use super::{Engine, EngineEvent, EngineSettings, Instrument, TimedEvent, VoiceRunner};
+use crate::tanpura::as_played::{Calibration, CalibrationRequest};
 
 /// Voices the plugin and the renderer allocate: the four drone strings plus four more for
 /// melody notes or overlapping cycles.
@@ -161,7 +162,44 @@ pub fn render_blocks<E>(
     runner: Option<VoiceRunner<'_>>,
     emit: &mut dyn FnMut(&[f32]) -> Result<(), E>,
 ) -> Result<(), E> {
+    render_blocks_calibrated(settings, &[], score, options, runner, emit)
+}
+
+/// What a score's strings need to be tuned as played (`tanpura/as_played.rs`): every string it
+/// plucks, none when the as-played tuning is off or the instrument is bowed. The renderer
+/// measures them ([`Calibration::measure`], off the audio thread and in parallel) and passes
+/// them to [`render_blocks_calibrated`].
+pub fn calibration_requests(settings: &EngineSettings, score: &Score) -> Vec<CalibrationRequest> {
+    if !settings.tuning.as_played || settings.instrument != Instrument::Tanpura {
+        return Vec::new();
+    }
+    let notes: Vec<u8> = score
+        .events
+        .iter()
+        .filter_map(|event| match event.action {
+            ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }) if velocity > 0.0 => {
+                Some(note)
+            }
+            _ => None,
+        })
+        .collect();
+    Engine::planned_strings(settings, &notes)
+}
+
+/// [`render_blocks`] with the strings tuned as played by `calibrations` (see
+/// [`calibration_requests`]); strings without one keep their linearised tuning.
+pub fn render_blocks_calibrated<E>(
+    settings: &EngineSettings,
+    calibrations: &[Calibration],
+    score: &Score,
+    options: &RenderOptions,
+    runner: Option<VoiceRunner<'_>>,
+    emit: &mut dyn FnMut(&[f32]) -> Result<(), E>,
+) -> Result<(), E> {
     let mut engine = Engine::new(settings, options.sample_rate_hz, options.voice_count);
+    for calibration in calibrations {
+        engine.set_calibration(calibration);
+    }
     let total = rendered_length(score, options);
     let block_size = options.block_size.max(1);
     let mut output = vec![0.0f32; block_size];

@@ -3,6 +3,7 @@
 
 use super::render::{render, RenderOptions, Score};
 use super::*;
+use crate::tanpura::quality::Quality;
 
 const RATE: f64 = 44_100.0;
 
@@ -228,7 +229,6 @@ fn snapshot_equals_the_loudest_string_exactly() {
 
 #[test]
 fn quality_change_keeps_ringing_strings_and_applies_from_the_next_pluck() {
-    use crate::tanpura::quality::Quality;
     let mut engine = Engine::new(&EngineSettings::default(), RATE, 2);
     run(&mut engine, &[note_on(0, 57)], 2_000);
     let mut settings = EngineSettings::default();
@@ -314,6 +314,7 @@ fn reference_pitch_and_fine_tuning_tune_notes_and_the_drone() {
         tuning: pitch::Tuning {
             a4_hz: 415.0,
             fine_tune_cents: 25.0,
+            as_played: true,
         },
         ..EngineSettings::default()
     };
@@ -369,4 +370,98 @@ fn nan_settings_neither_panic_nor_reach_the_output() {
     let bowed = run(&mut engine, &legato, 4410);
     assert!(bowed.iter().all(|x| x.is_finite()));
     assert!(peak(&bowed) > 0.0);
+}
+
+#[test]
+fn each_drone_string_has_its_own_fine_tuning_level_and_thread() {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Draft;
+    settings.drone.enabled = true;
+    settings.drone.strings[0] = drone::DroneString {
+        fine_tune_cents: -13.0,
+        level_db: -6.0,
+        thread_offset_m: 0.002,
+    };
+    settings.drone.strings[1].fine_tune_cents = 7.0;
+    let mut engine = Engine::new(&settings, RATE, 4);
+    engine.set_host_tempo(Some(120.0));
+    run(&mut engine, &[note_on(0, 50)], 22_100);
+    let sa_hz = pitch::note_to_hz(50);
+    let string = |index: usize| {
+        engine
+            .slots
+            .iter()
+            .find(|slot| slot.key == Some(StringKey::Drone(index)))
+            .unwrap_or_else(|| panic!("string {index} not plucked"))
+    };
+    let (first, second) = (string(0), string(1));
+    assert!(
+        (first.fundamental_hz / (0.75 * sa_hz * (-13.0f64 / 1200.0).exp2()) - 1.0).abs() < 1e-12
+    );
+    assert!((second.fundamental_hz / (sa_hz * (7.0f64 / 1200.0).exp2()) - 1.0).abs() < 1e-12);
+    let half = 10f64.powf(-6.0 / 20.0);
+    assert!((first.level_factor / pitch_level_factor(first.fundamental_hz) - half).abs() < 1e-12);
+    assert_eq!(
+        second.level_factor,
+        pitch_level_factor(second.fundamental_hz)
+    );
+    let thread = settings.voice.thread_position_m;
+    assert!((first.voice.settings().thread_position_m - (thread + 0.002)).abs() < 1e-12);
+    assert_eq!(second.voice.settings().thread_position_m, thread);
+}
+
+#[test]
+fn a_drone_string_at_minus_60_db_is_60_db_quieter() {
+    let peak_of_first_string = |level_db: f64| {
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = Quality::Draft;
+        settings.drone.enabled = true;
+        settings.drone.strings[0].level_db = level_db;
+        let mut engine = Engine::new(&settings, RATE, 4);
+        engine.set_host_tempo(Some(60.0));
+        // The second string comes a beat (1 s) later.
+        f64::from(peak(&run(&mut engine, &[note_on(0, 50)], 40_000)))
+    };
+    let ratio_db = 20.0 * (peak_of_first_string(-60.0) / peak_of_first_string(0.0)).log10();
+    assert!((ratio_db + 60.0).abs() < 1e-3, "{ratio_db} dB");
+}
+
+#[test]
+fn a_calibration_retunes_its_string_from_the_next_pluck_and_is_asked_for_once() {
+    use crate::tanpura::as_played::{Calibration, NOTE_VELOCITIES};
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Draft;
+    let mut engine = Engine::new(&settings, RATE, 2);
+    run(&mut engine, &[note_on(0, 57)], 64);
+    // Without a calibration the string aims at its note, and the engine asks for one, once.
+    let hz = pitch::note_to_hz(57);
+    assert_eq!(engine.slots[0].tuned_hz, hz);
+    let request = engine
+        .take_wanted_calibration()
+        .expect("a calibration is wanted");
+    assert_eq!(request.velocities, NOTE_VELOCITIES);
+    assert_eq!(request.settings.fundamental_hz, hz);
+    assert_eq!(engine.take_wanted_calibration(), None);
+    // What a renderer plans is the string the engine plucks (k_b equal to round-off: the engine's
+    // passes through its logarithmic glide).
+    let planned = Engine::planned_strings(&settings, &[57, 57]);
+    assert_eq!(planned.len(), 1);
+    let calibration = Calibration {
+        request: planned[0],
+        sample_rate_hz: RATE,
+        offset_cents: 3.0,
+    };
+    assert!(calibration.is_for(&request, RATE));
+    engine.set_calibration(&calibration);
+    run(&mut engine, &[note_on(0, 57)], 64);
+    let slot = &engine.slots[0];
+    assert!((slot.tuned_hz / (hz * (3.0f64 / 1200.0).exp2()) - 1.0).abs() < 1e-12);
+    assert_eq!(slot.fundamental_hz, hz);
+    assert_eq!(engine.take_wanted_calibration(), None, "it is current now");
+
+    // Off: the linearised tuning only, and nothing is asked for.
+    settings.tuning.as_played = false;
+    engine.set_settings(&settings);
+    run(&mut engine, &[note_on(0, 57)], 64);
+    assert_eq!(engine.slots[0].tuned_hz, hz);
 }

@@ -16,6 +16,7 @@
 //! `voice.rs` turns musician-facing settings into a tuned string of the chosen tier;
 //! `instrument.rs` is the four-string drone.
 
+pub mod as_played;
 pub mod body;
 pub mod contact;
 pub mod excitation;

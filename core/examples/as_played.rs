@@ -1,0 +1,105 @@
+//! The sustained pitch as played (0.3–1.5 s after the pluck) against each key's target, for one
+//! tier, with the linearised tuning alone and with the as-played calibration
+//! (`tanpura/as_played.rs`): `cargo run --release -p javari-core --example as_played -- TIER KEY…`
+//! (TIER: draft, live, studio or reference; keys default to 36–64). One row per key, one
+//! column per MIDI velocity, cents from the key's pitch; the last column is the largest
+//! deviation at velocities 40–110.
+
+use javari_core::analysis::cents;
+use javari_core::engine::pitch::note_to_hz;
+use javari_core::tanpura::as_played::{
+    as_played_offset_cents, sustained_pitch_of_pluck_hz, NOTE_VELOCITIES,
+};
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::quality::Quality;
+use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+const SAMPLE_RATE: f64 = 44_100.0;
+const VELOCITIES: [u8; 6] = [1, 40, 60, 80, 110, 127];
+
+fn row(voice: &mut TanpuraVoice, key: u8, offset_cents: f64) -> (String, f64) {
+    let nominal = note_to_hz(key);
+    let mut text = String::new();
+    let mut worst: f64 = 0.0;
+    for velocity in VELOCITIES {
+        let heard = sustained_pitch_of_pluck_hz(
+            voice,
+            nominal * (offset_cents / 1200.0).exp2(),
+            nominal,
+            &Pluck::default(),
+            f64::from(velocity) / 127.0,
+            SAMPLE_RATE,
+        );
+        let off = cents(heard, nominal);
+        if (40..=110).contains(&velocity) {
+            worst = worst.max(off.abs());
+        }
+        text += &format!("{off:>8.2}");
+    }
+    (text, worst)
+}
+
+fn main() {
+    let arguments: Vec<String> = std::env::args().skip(1).collect();
+    let quality = arguments
+        .first()
+        .and_then(|name| Quality::from_name(name))
+        .unwrap_or(Quality::Live);
+    let mut keys: Vec<u8> = arguments
+        .iter()
+        .skip(1)
+        .filter_map(|key| key.parse().ok())
+        .collect();
+    if keys.is_empty() {
+        keys = (36..=64).collect();
+    }
+    let rows = Mutex::new(Vec::new());
+    let next = AtomicUsize::new(0);
+    std::thread::scope(|scope| {
+        for _ in 0..std::thread::available_parallelism().map_or(2, |n| n.get()) {
+            scope.spawn(|| loop {
+                let Some(&key) = keys.get(next.fetch_add(1, Ordering::Relaxed)) else {
+                    break;
+                };
+                let settings = VoiceSettings {
+                    fundamental_hz: note_to_hz(key),
+                    quality,
+                    ..VoiceSettings::default()
+                };
+                let offset = as_played_offset_cents(
+                    &settings,
+                    &Pluck::default(),
+                    NOTE_VELOCITIES,
+                    SAMPLE_RATE,
+                );
+                let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
+                let linearised = row(&mut voice, key, 0.0);
+                let played = row(&mut voice, key, offset);
+                rows.lock()
+                    .expect("a row thread panicked")
+                    .push((key, offset, linearised, played));
+            });
+        }
+    });
+    let mut rows = rows.into_inner().expect("a row thread panicked");
+    rows.sort_by_key(|row| row.0);
+    println!(
+        "{} tier, cents from the key's pitch at MIDI velocities {VELOCITIES:?}",
+        quality.name()
+    );
+    println!("key  offset | linearised tuning                                | worst | as played                                        | worst");
+    let (mut worst_linearised, mut worst_played): (f64, f64) = (0.0, 0.0);
+    for (key, offset, linearised, played) in rows {
+        println!(
+            "{key:>3} {offset:>7.2} |{}| {:>5.2} |{}| {:>5.2}",
+            linearised.0, linearised.1, played.0, played.1
+        );
+        worst_linearised = worst_linearised.max(linearised.1);
+        worst_played = worst_played.max(played.1);
+    }
+    println!(
+        "largest deviation at velocities 40-110: linearised {worst_linearised:.2} cents, as played {worst_played:.2} cents"
+    );
+}
