@@ -19,10 +19,14 @@
 //! changes (nice-plug passes that on as CLAP `latency.changed` after a restart, VST3
 //! `restartComponent(kLatencyChanged)`); a state blob is repaired before it loads ([`state`]);
 //! `process` runs with subnormals flushed to zero (`javari_core::denormals`).
+//!
+//! Each string is tuned by its sustained pitch as played once [`tuning_worker`] has measured
+//! it on its own thread (a string plucked before that plays with its linearised tuning).
 
 pub mod editor;
 pub mod params;
 pub mod state;
+pub mod tuning_worker;
 
 use editor::channel::{SnapshotChannel, SnapshotPublisher, QUEUE_FRAMES};
 use javari_core::denormals::FlushDenormals;
@@ -35,6 +39,7 @@ use params::JavariParams;
 use std::num::NonZeroU32;
 use std::sync::Arc;
 use std::time::Instant;
+use tuning_worker::TuningWorker;
 
 /// The factory presets, compiled in from `presets/` (the files `render --preset` reads).
 pub const FACTORY_PRESET_FILES: [(&str, &str); params::FACTORY_PRESET_COUNT] = [
@@ -97,6 +102,8 @@ pub struct Javari {
     /// The audio thread's end of the editor channel (measures load, publishes snapshots).
     snapshots: SnapshotPublisher,
     editor_state: Arc<editor::EguiEditorState>,
+    /// Measures the strings' as-played tuning off the audio thread; started in `activate`.
+    tuning: Option<TuningWorker>,
 }
 
 impl Default for Javari {
@@ -109,6 +116,7 @@ impl Default for Javari {
             mono: Vec::new(),
             snapshots: SnapshotPublisher::new(SnapshotChannel::new(QUEUE_FRAMES)),
             editor_state: editor::default_state(),
+            tuning: None,
         }
     }
 }
@@ -167,6 +175,9 @@ impl Plugin for Javari {
         };
         context.set_latency_samples(latency_in_samples(&engine));
         self.engine = Some(engine);
+        if self.tuning.is_none() {
+            self.tuning = Some(TuningWorker::start());
+        }
         self.snapshots.prepare(rate);
         self.mono
             .resize(buffer_config.max_buffer_size.max(1) as usize, 0.0);
@@ -272,6 +283,9 @@ impl Plugin for Javari {
                 channel[start..end].copy_from_slice(mono);
             }
             start = end;
+        }
+        if let Some(tuning) = &self.tuning {
+            tuning.exchange(engine);
         }
         self.snapshots.end_block(engine, samples, started.elapsed());
         ProcessStatus::KeepAlive
