@@ -72,6 +72,22 @@ pub const FACTORY_PRESET_FILES: [(&str, &str); params::FACTORY_PRESET_COUNT] = [
         "presets/bowed-flautando.toml",
         include_str!("../../presets/bowed-flautando.toml"),
     ),
+    (
+        "presets/male-tanpura.toml",
+        include_str!("../../presets/male-tanpura.toml"),
+    ),
+    (
+        "presets/female-tanpura.toml",
+        include_str!("../../presets/female-tanpura.toml"),
+    ),
+    (
+        "presets/five-string-tanpura.toml",
+        include_str!("../../presets/five-string-tanpura.toml"),
+    ),
+    (
+        "presets/tanpura-ma.toml",
+        include_str!("../../presets/tanpura-ma.toml"),
+    ),
 ];
 
 /// Parses the compiled-in factory presets (a test checks that they parse).
@@ -334,7 +350,11 @@ mod tests {
                 "Bowed violin",
                 "Bowed cello",
                 "Sul ponticello",
-                "Flautando (bow table)"
+                "Flautando (bow table)",
+                "Male tanpura",
+                "Female tanpura",
+                "Five-string tanpura",
+                "Tanpura in Ma"
             ]
         );
     }

@@ -91,6 +91,18 @@ pub enum PresetChoice {
     #[id = "bowed-flautando"]
     #[name = "Flautando"]
     Flautando,
+    #[id = "male-tanpura"]
+    #[name = "Male tanpura"]
+    MaleTanpura,
+    #[id = "female-tanpura"]
+    #[name = "Female tanpura"]
+    FemaleTanpura,
+    #[id = "five-string-tanpura"]
+    #[name = "Five-string tanpura"]
+    FiveString,
+    #[id = "tanpura-ma"]
+    #[name = "Tanpura in Ma"]
+    TanpuraMa,
 }
 
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -559,7 +571,8 @@ pub const BRIDGE_STIFFNESS_LOG10_RANGE: (f32, f32) = (5.0, 11.0);
 
 impl JavariParams {
     /// The engine settings the parameters describe; a factory preset other than `Custom`
-    /// replaces the sound (every parameter but quality, output gain and the drone controls).
+    /// replaces the sound (every parameter but quality, output gain and the drone controls; a
+    /// drone preset brings its drone too).
     pub fn engine_settings(&self, factory: &[Preset; FACTORY_PRESET_COUNT]) -> EngineSettings {
         let gain_db = f64::from(self.output_gain_db.value());
         let drone_from_knobs = javari_core::engine::drone::DroneSettings {
@@ -595,6 +608,10 @@ impl JavariParams {
             PresetChoice::BowedCello => Some(&factory[5]),
             PresetChoice::SulPonticello => Some(&factory[6]),
             PresetChoice::Flautando => Some(&factory[7]),
+            PresetChoice::MaleTanpura => Some(&factory[8]),
+            PresetChoice::FemaleTanpura => Some(&factory[9]),
+            PresetChoice::FiveString => Some(&factory[10]),
+            PresetChoice::TanpuraMa => Some(&factory[11]),
         };
         let quality = match self.quality.value() {
             QualityChoice::Draft => Quality::Draft,
@@ -617,7 +634,11 @@ impl JavariParams {
             settings.voice.quality = quality;
             settings.tanpura_output = tanpura_output;
             settings.output_gain_db += gain_db;
-            settings.drone = drone_from_knobs;
+            // A drone preset brings its drone (pattern, first string, cycle, strings); any other
+            // keeps the drone knobs.
+            if !preset.settings.drone.enabled {
+                settings.drone = drone_from_knobs;
+            }
             return settings;
         }
         let voice = VoiceSettings {
@@ -670,4 +691,4 @@ impl JavariParams {
 }
 
 /// Number of factory presets (`presets/*.toml`, compiled into the plugin).
-pub const FACTORY_PRESET_COUNT: usize = 8;
+pub const FACTORY_PRESET_COUNT: usize = 12;
