@@ -59,27 +59,26 @@ fn main() {
     let next = AtomicUsize::new(0);
     std::thread::scope(|scope| {
         for _ in 0..std::thread::available_parallelism().map_or(2, |n| n.get()) {
-            scope.spawn(|| loop {
-                let Some(&key) = keys.get(next.fetch_add(1, Ordering::Relaxed)) else {
-                    break;
-                };
-                let settings = VoiceSettings {
-                    fundamental_hz: note_to_hz(key),
-                    quality,
-                    ..VoiceSettings::default()
-                };
-                let offset = as_played_offset_cents(
-                    &settings,
-                    &Pluck::default(),
-                    NOTE_VELOCITIES,
-                    SAMPLE_RATE,
-                );
-                let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
-                let linearised = row(&mut voice, key, 0.0);
-                let played = row(&mut voice, key, offset);
-                rows.lock()
-                    .expect("a row thread panicked")
-                    .push((key, offset, linearised, played));
+            scope.spawn(|| {
+                while let Some(&key) = keys.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    let settings = VoiceSettings {
+                        fundamental_hz: note_to_hz(key),
+                        quality,
+                        ..VoiceSettings::default()
+                    };
+                    let offset = as_played_offset_cents(
+                        &settings,
+                        &Pluck::default(),
+                        NOTE_VELOCITIES,
+                        SAMPLE_RATE,
+                    );
+                    let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
+                    let linearised = row(&mut voice, key, 0.0);
+                    let played = row(&mut voice, key, offset);
+                    rows.lock()
+                        .expect("a row thread panicked")
+                        .push((key, offset, linearised, played));
+                }
             });
         }
     });
