@@ -8,7 +8,8 @@
 //! MIDI: note-on plucks the string tuned to that note (12-TET, A4 = 440 Hz) with the pluck
 //! amplitude scaled by velocity; note-off releases the note (the string rings on; in drone mode
 //! releasing the last held note stops the cycle); CC 120 silences every string; CC 123 releases
-//! every note. The output is stereo with the same signal on both channels.
+//! every note. The output is stereo: the strings spread over the image by *Stereo width*
+//! (`Engine::process_stereo`; the mono sum is exactly the mono output).
 //!
 //! With the `inst` parameter on Bowed, the same events play one bowed string
 //! (`javari_core::bowed::instrument` documents that mapping): CCs, channel and per-note pressure
@@ -114,7 +115,10 @@ pub struct Javari {
     /// Built in `activate` (it allocates the strings); `None` before.
     engine: Option<Engine>,
     events: Vec<TimedEvent>,
+    /// The left channel, then the mid signal the editor is shown.
     mono: Vec<f32>,
+    /// The right channel.
+    right: Vec<f32>,
     /// The audio thread's end of the editor channel (measures load, publishes snapshots).
     snapshots: SnapshotPublisher,
     editor_state: Arc<editor::EguiEditorState>,
@@ -130,6 +134,7 @@ impl Default for Javari {
             engine: None,
             events: Vec::with_capacity(EVENT_CAPACITY),
             mono: Vec::new(),
+            right: Vec::new(),
             snapshots: SnapshotPublisher::new(SnapshotChannel::new(QUEUE_FRAMES)),
             editor_state: editor::default_state(),
             tuning: None,
@@ -196,6 +201,8 @@ impl Plugin for Javari {
         }
         self.snapshots.prepare(rate);
         self.mono
+            .resize(buffer_config.max_buffer_size.max(1) as usize, 0.0);
+        self.right
             .resize(buffer_config.max_buffer_size.max(1) as usize, 0.0);
         true
     }
@@ -292,12 +299,18 @@ impl Plugin for Javari {
                 self.events[next_event].offset -= start.min(self.events[next_event].offset);
                 next_event += 1;
             }
-            let mono = &mut self.mono[..end - start];
-            engine.process(&self.events[first_event..next_event], mono);
-            self.snapshots.record_output(mono);
-            for channel in channels.iter_mut() {
-                channel[start..end].copy_from_slice(mono);
+            let left = &mut self.mono[..end - start];
+            let right = &mut self.right[..end - start];
+            engine.process_stereo(&self.events[first_event..next_event], left, right);
+            for (index, channel) in channels.iter_mut().enumerate() {
+                let source: &[f32] = if index % 2 == 0 { left } else { right };
+                channel[start..end].copy_from_slice(source);
             }
+            // The editor shows the mid signal (the mono output).
+            for (left, right) in left.iter_mut().zip(right.iter()) {
+                *left = 0.5 * (*left + *right);
+            }
+            self.snapshots.record_output(left);
             start = end;
         }
         if let Some(tuning) = &self.tuning {

@@ -309,6 +309,8 @@ pub struct JavariParams {
     /// Tune each string by its sustained pitch as played (measured on a background thread).
     #[id = "asplay"]
     pub tune_as_played: BoolParam,
+    #[id = "width"]
+    pub stereo_width_percent: FloatParam,
     #[id = "inst"]
     pub instrument: EnumParam<InstrumentChoice>,
     #[id = "bmodel"]
@@ -506,6 +508,16 @@ impl Default for JavariParams {
             drone_seed: IntParam::new("Humanise seed", 0, IntRange::Linear { min: 0, max: 9999 }),
             drone_strings: Default::default(),
             tune_as_played: BoolParam::new("Tune as played", true),
+            stereo_width_percent: FloatParam::new(
+                "Stereo width",
+                (javari_core::engine::DEFAULT_STEREO_WIDTH * 100.0) as f32,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: 100.0,
+                },
+            )
+            .with_unit(" %")
+            .with_step_size(1.0),
             instrument: EnumParam::new("Instrument", InstrumentChoice::Tanpura),
             bow_model: EnumParam::new("Bow model", BowModelChoice::RoundedCorner),
             bowed_string: EnumParam::new("Bowed string", BowedStringChoice::ViolinA),
@@ -628,11 +640,13 @@ impl JavariParams {
             fine_tune_cents: f64::from(self.fine_tune_cents.value()),
             as_played: self.tune_as_played.value(),
         };
+        let stereo_width = f64::from(self.stereo_width_percent.value()) / 100.0;
         if let Some(preset) = preset {
             let mut settings = preset.settings;
             settings.tuning = tuning;
             settings.voice.quality = quality;
             settings.tanpura_output = tanpura_output;
+            settings.stereo_width = stereo_width;
             settings.output_gain_db += gain_db;
             // A drone preset brings its drone (pattern, first string, cycle, strings); any other
             // keeps the drone knobs.
@@ -663,6 +677,7 @@ impl JavariParams {
             drone: drone_from_knobs,
             tanpura_output,
             tuning,
+            stereo_width,
             instrument: match self.instrument.value() {
                 InstrumentChoice::Tanpura => Instrument::Tanpura,
                 InstrumentChoice::Bowed => Instrument::Bowed,

@@ -57,6 +57,10 @@ pub const NEWTONS_AT_FULL_SCALE: f64 = 2.0;
 pub const CONTROL_INTERVAL: u64 = 32;
 /// Time a continuous setting takes to reach a new value, s.
 pub const SMOOTHING_TIME_S: f64 = 0.02;
+/// The stereo width a new engine has (0–1).
+pub const DEFAULT_STEREO_WIDTH: f64 = 0.5;
+/// Notes this many semitones either side of middle C sit at the stereo image's edges.
+const NOTE_PAN_SPAN_SEMITONES: f64 = 24.0;
 /// Output gain range, dB.
 pub const OUTPUT_GAIN_RANGE_DB: (f64, f64) = (-60.0, 24.0);
 /// Time constant of each voice's level follower (used to pick the quietest voice to steal), s.
@@ -155,6 +159,9 @@ pub struct EngineSettings {
     pub tanpura_output: TanpuraOutput,
     /// Reference pitch and fine tuning of every note (MIDI notes and the drone's Sa).
     pub tuning: pitch::Tuning,
+    /// How far the strings spread over the stereo image ([`Engine::process_stereo`]), 0–1
+    /// (0: both channels the same).
+    pub stereo_width: f64,
 }
 
 impl Default for EngineSettings {
@@ -168,6 +175,7 @@ impl Default for EngineSettings {
             bowed: BowedEngineSettings::default(),
             tanpura_output: TanpuraOutput::Pickup,
             tuning: pitch::Tuning::default(),
+            stereo_width: DEFAULT_STEREO_WIDTH,
         }
     }
 }
@@ -244,6 +252,7 @@ impl EngineSettings {
             },
             instrument: self.instrument,
             tanpura_output: self.tanpura_output,
+            stereo_width: clamp_or(self.stereo_width, (0.0, 1.0), default.stereo_width),
             tuning: pitch::Tuning {
                 a4_hz: clamp_or(self.tuning.a4_hz, pitch::A4_RANGE_HZ, default.tuning.a4_hz),
                 fine_tune_cents: clamp_or(
@@ -374,6 +383,8 @@ struct Slot {
     tuned_hz: f64,
     /// Output scaling that keeps the level independent of pitch (see [`pitch_level_factor`]).
     level_factor: f64,
+    /// Where the string sits in the stereo image, −1 (left) to 1 (right), before the width.
+    pan: f32,
     /// Absolute sample of the last pluck.
     plucked_at: u64,
     /// Peak-following level of the scaled output, for stealing.
@@ -438,6 +449,15 @@ pub fn pitch_level_factor(fundamental_hz: f64) -> f64 {
     ratio * ratio
 }
 
+/// A drone string's place in the stereo image: the strings in playing order spread evenly from
+/// left (−1) to right (1).
+fn drone_string_pan(string: usize, count: usize) -> f32 {
+    if count < 2 {
+        return 0.0;
+    }
+    (2.0 * string.min(count - 1) as f64 / (count - 1) as f64 - 1.0) as f32
+}
+
 /// The soft and firm ends of a drone string's plucks (fractions of full): full strength, less
 /// the humanisation's largest softening.
 fn drone_velocities(drone: &DroneSettings) -> [f64; 2] {
@@ -472,6 +492,9 @@ pub struct Engine {
     scratch: Vec<Vec<f32>>,
     /// The tanpura's body, between the strings' total bridge force and the output.
     body: Body,
+    /// The same body for the side signal (the strings' panned bridge forces), so that the
+    /// stereo image is the body's sound too.
+    side_body: Body,
     /// Each string's tuning by its sustained pitch as played (`tanpura/as_played.rs`).
     as_played: AsPlayedTuning,
     /// Strings plucked without a current calibration, for the host to measure off the audio
@@ -508,6 +531,7 @@ impl Engine {
                 fundamental_hz: voice.fundamental_hz,
                 tuned_hz: voice.fundamental_hz,
                 level_factor: 1.0,
+                pan: 0.0,
                 plucked_at: 0,
                 level: 0.0,
             })
@@ -548,6 +572,7 @@ impl Engine {
             applied_bow_controls: None,
             scratch: Vec::new(),
             body: Body::new(&TANPURA_BODY, sample_rate_hz),
+            side_body: Body::new(&TANPURA_BODY, sample_rate_hz),
             as_played: AsPlayedTuning::default(),
             wanted: [None; WANTED_CAPACITY],
         };
@@ -763,6 +788,7 @@ impl Engine {
         }
         self.drone.reset();
         self.body.reset();
+        self.side_body.reset();
         self.clock = 0;
         self.next_control_tick = 0;
         for instrument in &mut self.bowed {
@@ -776,7 +802,26 @@ impl Engine {
     /// offsets. Events must be sorted by offset; an offset past the block is applied at its last
     /// sample. Allocation-free, never panics.
     pub fn process(&mut self, events: &[TimedEvent], output: &mut [f32]) {
-        self.process_inner(events, output, None);
+        self.process_inner(events, output, None, None);
+    }
+
+    /// [`Engine::process`] in stereo: the mid signal `M` is exactly [`Engine::process`]'s, the
+    /// side signal `S` the strings' outputs weighted by their places in the image (drone
+    /// strings spread evenly from left to right in playing order, notes by pitch: two octaves
+    /// either side of middle C at the edges) times [`EngineSettings::stereo_width`], through its
+    /// own copy of the body when the output is radiated; `left = M − S`, `right = M + S`. So the
+    /// mono sum `(left + right) / 2` is the mono output (mono-compatible by construction) and a
+    /// width of 0 gives two equal channels. `left` and `right` must have the same length.
+    /// Allocation-free, never panics.
+    pub fn process_stereo(&mut self, events: &[TimedEvent], left: &mut [f32], right: &mut [f32]) {
+        let length = left.len().min(right.len());
+        let (left, right) = (&mut left[..length], &mut right[..length]);
+        self.process_inner(events, left, Some(&mut *right), None);
+        for (left, right) in left.iter_mut().zip(right.iter_mut()) {
+            let (mid, side) = (*left, *right);
+            *left = mid - side;
+            *right = mid + side;
+        }
     }
 
     /// [`Engine::process`] with the voices of each segment run by `runner` (offline rendering
@@ -789,16 +834,21 @@ impl Engine {
         output: &mut [f32],
         runner: VoiceRunner<'_>,
     ) {
-        self.process_inner(events, output, Some(runner));
+        self.process_inner(events, output, None, Some(runner));
     }
 
+    /// Renders the mid signal into `output` and, when given, the side signal into `side`.
     fn process_inner(
         &mut self,
         events: &[TimedEvent],
         output: &mut [f32],
+        mut side: Option<&mut [f32]>,
         runner: Option<VoiceRunner<'_>>,
     ) {
         output.fill(0.0);
+        if let Some(side) = side.as_deref_mut() {
+            side.fill(0.0);
+        }
         let length = output.len();
         let mut position = 0;
         let mut next_event = 0;
@@ -829,13 +879,20 @@ impl Engine {
                 end = end.min(position + until.min(length as u64) as usize);
             }
             let end = end.max(position + 1);
-            self.render_segment(&mut output[position..end], runner);
+            let side_segment = side.as_deref_mut().map(|side| &mut side[position..end]);
+            self.render_segment(&mut output[position..end], side_segment, runner);
             self.clock += (end - position) as u64;
             position = end;
         }
     }
 
-    fn render_segment(&mut self, output: &mut [f32], runner: Option<VoiceRunner<'_>>) {
+    fn render_segment(
+        &mut self,
+        output: &mut [f32],
+        mut side: Option<&mut [f32]>,
+        runner: Option<VoiceRunner<'_>>,
+    ) {
+        let width = self.target.stereo_width as f32;
         if self.target.instrument == Instrument::Bowed {
             let scale = 1.0 / BOWED_NEWTONS_AT_FULL_SCALE;
             let bowed = self.bowed_mut();
@@ -855,9 +912,18 @@ impl Engine {
             // The audio thread: each voice adds into the output in turn.
             None => {
                 for slot in &mut self.slots {
-                    run_slot(slot, release, output.len(), |index, value| {
-                        output[index] += value
-                    });
+                    match side.as_deref_mut() {
+                        Some(side) => {
+                            let weight = slot.pan * width;
+                            run_slot(slot, release, output.len(), |index, value| {
+                                output[index] += value;
+                                side[index] += weight * value;
+                            });
+                        }
+                        None => run_slot(slot, release, output.len(), |index, value| {
+                            output[index] += value
+                        }),
+                    }
                 }
             }
             // Offline: each active voice fills its own buffer, on whatever thread the runner
@@ -885,8 +951,15 @@ impl Engine {
                     .collect();
                 runner(&mut tasks);
                 for task in &tasks {
-                    for (sample, value) in output.iter_mut().zip(&task.samples[..task.written]) {
+                    let samples = &task.samples[..task.written];
+                    for (sample, value) in output.iter_mut().zip(samples) {
                         *sample += *value;
+                    }
+                    if let Some(side) = side.as_deref_mut() {
+                        let weight = task.slot.pan * width;
+                        for (sample, value) in side.iter_mut().zip(samples) {
+                            *sample += weight * *value;
+                        }
                     }
                 }
             }
@@ -899,9 +972,25 @@ impl Engine {
             for sample in output.iter_mut() {
                 *sample = self.body.tick(f64::from(*sample)) as f32;
             }
+            if let Some(side) = side.as_deref_mut() {
+                for sample in side.iter_mut() {
+                    *sample = self.side_body.tick(f64::from(*sample)) as f32;
+                }
+            }
         }
-        for sample in output.iter_mut() {
-            *sample *= self.output_gain.step() as f32;
+        match side {
+            Some(side) => {
+                for (sample, side) in output.iter_mut().zip(side.iter_mut()) {
+                    let gain = self.output_gain.step() as f32;
+                    *sample *= gain;
+                    *side *= gain;
+                }
+            }
+            None => {
+                for sample in output.iter_mut() {
+                    *sample *= self.output_gain.step() as f32;
+                }
+            }
         }
     }
 
@@ -1117,6 +1206,16 @@ impl Engine {
             StringKey::Drone(string) => self.target.drone.strings[string].level_factor(),
             StringKey::Note(_) => 1.0,
         };
+        let pan = match key {
+            StringKey::Drone(string) => {
+                let (_, count) =
+                    string_ratios(self.target.drone.first_string, self.target.drone.pattern);
+                drone_string_pan(string, count)
+            }
+            StringKey::Note(note) => {
+                ((f64::from(note) - 60.0) / NOTE_PAN_SPAN_SEMITONES).clamp(-1.0, 1.0) as f32
+            }
+        };
         let slot = &mut self.slots[index];
         if slot.key != Some(key) || slot.fundamental_hz != fundamental_hz {
             // A stolen string is stopped first: its old vibration belongs to another tuning.
@@ -1125,6 +1224,7 @@ impl Engine {
             slot.fundamental_hz = fundamental_hz;
         }
         slot.tuned_hz = string_settings.fundamental_hz;
+        slot.pan = pan;
         slot.level_factor = pitch_level_factor(fundamental_hz) * level;
         // Also brings a re-plucked string to the current quality tier.
         slot.voice.set_settings(&string_settings);

@@ -40,6 +40,7 @@
 //! | `drone_string_level_db` | dB | up to 6 of −60–6 | each drone string's level |
 //! | `drone_string_thread_offset_m` | m | up to 6 of −0.005–0.005 | each drone string's thread, from `thread_position_m` |
 //! | `tune_as_played` | bool | | tune each string by its sustained pitch as played (`tanpura/as_played.rs`) |
+//! | `stereo_width` | 1 | 0–1 | how far the strings spread over the stereo image (0: mono) |
 //! | `instrument` | text | tanpura, bowed | which instrument plays |
 //! | `bow_model` | text | rounded-corner, bow-table | the bowed tier |
 //! | `bow_string` | text | violin-a, cello-d | the bowed string's constants |
@@ -161,7 +162,7 @@ impl Kind {
 }
 
 /// Every key and what it takes, in the order of [`PresetFile`] and of the table above.
-const KEYS: [(&str, Kind); 39] = [
+const KEYS: [(&str, Kind); 40] = [
     ("name", Kind::Text),
     (
         "bridge_stiffness_n_m2",
@@ -219,6 +220,7 @@ const KEYS: [(&str, Kind); 39] = [
         Kind::Numbers(STRING_THREAD_OFFSET_RANGE_M),
     ),
     ("tune_as_played", Kind::Switch),
+    ("stereo_width", Kind::Number((0.0, 1.0))),
     ("instrument", Kind::Choice(&INSTRUMENT_NAMES)),
     ("bow_model", Kind::Choice(&BOW_MODEL_NAMES)),
     ("bow_string", Kind::Choice(&BOW_STRING_NAMES)),
@@ -271,6 +273,7 @@ struct PresetFile {
     drone_string_level_db: Option<Spanned<Vec<f64>>>,
     drone_string_thread_offset_m: Option<Spanned<Vec<f64>>>,
     tune_as_played: Option<Spanned<bool>>,
+    stereo_width: Option<Spanned<f64>>,
     instrument: Option<Spanned<String>>,
     bow_model: Option<Spanned<String>>,
     bow_string: Option<Spanned<String>>,
@@ -590,6 +593,10 @@ impl Preset {
             strings[index].thread_offset_m = value;
         }
         set_switch(&mut settings.tuning.as_played, switch(read.tune_as_played));
+        set(
+            &mut settings.stereo_width,
+            check.number("stereo_width", read.stereo_width)?,
+        );
         if let Some(seed) = check.number("drone_humanize_seed", read.drone_humanize_seed)? {
             // In range, so the conversion only drops a fraction.
             settings.drone.humanize_seed = seed as u32;
@@ -680,6 +687,7 @@ impl Preset {
                 s.drone.strings.map(|string| string.thread_offset_m),
             ),
             tune_as_played: Some(Spanned::new(0..0, s.tuning.as_played)),
+            stereo_width: value(s.stereo_width),
             instrument: text(INSTRUMENT_NAMES[s.instrument as usize]),
             bow_model: text(BOW_MODEL_NAMES[s.bowed.player.tier as usize]),
             bow_string: text(BOW_STRING_NAMES[s.bowed.string as usize]),

@@ -465,3 +465,69 @@ fn a_calibration_retunes_its_string_from_the_next_pluck_and_is_asked_for_once() 
     run(&mut engine, &[note_on(0, 57)], 64);
     assert_eq!(engine.slots[0].tuned_hz, hz);
 }
+
+fn stereo(engine: &mut Engine, events: &[TimedEvent], samples: usize) -> (Vec<f32>, Vec<f32>) {
+    let (mut left, mut right) = (vec![0.0; samples], vec![0.0; samples]);
+    for (index, (left, right)) in left.chunks_mut(256).zip(right.chunks_mut(256)).enumerate() {
+        let events: &[TimedEvent] = if index == 0 { events } else { &[] };
+        engine.process_stereo(events, left, right);
+    }
+    (left, right)
+}
+
+fn radiated_drone(width: f64) -> EngineSettings {
+    let mut settings = radiated();
+    settings.voice.quality = Quality::Draft;
+    settings.drone.enabled = true;
+    settings.stereo_width = width;
+    settings
+}
+
+#[test]
+fn the_stereo_mid_is_the_mono_output_and_width_zero_is_two_equal_channels() {
+    let settings = radiated_drone(1.0);
+    let samples = 3 * 44_100;
+    let mut mono_engine = Engine::new(&settings, RATE, 4);
+    mono_engine.set_host_tempo(Some(120.0));
+    let mut mono = vec![0.0f32; samples];
+    for (index, block) in mono.chunks_mut(256).enumerate() {
+        let events: &[TimedEvent] = if index == 0 { &[note_on(0, 50)] } else { &[] };
+        mono_engine.process(events, block);
+    }
+    let mut stereo_engine = Engine::new(&settings, RATE, 4);
+    stereo_engine.set_host_tempo(Some(120.0));
+    let (left, right) = stereo(&mut stereo_engine, &[note_on(0, 50)], samples);
+    let mut side_energy = 0.0;
+    for ((left, right), mono) in left.iter().zip(&right).zip(&mono) {
+        // (M − S) + (M + S) = 2M up to the rounding of the two sums.
+        assert!(
+            (0.5 * (left + right) - mono).abs() <= 1e-6 * (left.abs() + right.abs()),
+            "{left} {right} {mono}"
+        );
+        side_energy += f64::from(left - right).powi(2);
+    }
+    assert!(side_energy > 0.0, "width 1 spreads the strings");
+
+    let mut narrow = Engine::new(&radiated_drone(0.0), RATE, 4);
+    narrow.set_host_tempo(Some(120.0));
+    let (left, right) = stereo(&mut narrow, &[note_on(0, 50)], samples);
+    assert_eq!(left, right);
+    assert_eq!(left, mono);
+}
+
+#[test]
+fn the_first_drone_string_sounds_on_the_left_and_the_last_on_the_right() {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Draft;
+    settings.drone.enabled = true;
+    settings.stereo_width = 1.0;
+    let mut engine = Engine::new(&settings, RATE, 4);
+    engine.set_host_tempo(Some(60.0));
+    // The first string alone for its first second (pickup output: no body in between).
+    let (left, right) = stereo(&mut engine, &[note_on(0, 50)], 40_000);
+    let energy = |signal: &[f32]| signal.iter().map(|x| f64::from(*x).powi(2)).sum::<f64>();
+    assert!(energy(&left) > 0.0);
+    assert_eq!(energy(&right), 0.0, "pan −1 at full width: left only");
+    assert_eq!(drone_string_pan(3, 4), 1.0);
+    assert_eq!(drone_string_pan(1, 5), -0.5);
+}
