@@ -8,12 +8,18 @@
 //! little-endian f32, exactly what the engine produced), keyed by the pluck's engine settings,
 //! the render length and rate, and the version of `core/` (its git tree, plus the hash of any
 //! uncommitted change to it). Without git the cache is not used. Renders run on all cores (rayon).
+//!
+//! Every pluck is tuned as `cargo xtask render` tunes it, by its sustained pitch as played
+//! (`javari_core::tanpura::as_played`): each tier's string at each key and pluck position is
+//! calibrated on that tier first (the reference's calibrations are cached beside its renders).
 
 use javari_core::analysis::cents;
 use javari_core::analysis::listening::{compare, sustained_pitch_hz, ListeningDifference};
 use javari_core::analysis::playing_range::{
-    full_grid, render, settings_for, GridPoint, NOTE_SECONDS,
+    calibrate, full_grid, render_as_played, settings_for, GridPoint, KEYS, NOTE_SECONDS,
+    PLUCK_POSITIONS_M,
 };
+use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
 use rayon::prelude::*;
 use std::collections::hash_map::DefaultHasher;
@@ -93,6 +99,7 @@ fn core_version(workspace: &Path) -> Option<String> {
 
 fn cache_file(directory: &Path, version: &str, point: &GridPoint, sample_rate_hz: f64) -> PathBuf {
     let mut hasher = DefaultHasher::new();
+    "tuned as played".hash(&mut hasher);
     version.hash(&mut hasher);
     format!("{:?}", settings_for(Quality::Reference, point)).hash(&mut hasher);
     point.key.hash(&mut hasher);
@@ -100,6 +107,55 @@ fn cache_file(directory: &Path, version: &str, point: &GridPoint, sample_rate_hz
     NOTE_SECONDS.to_bits().hash(&mut hasher);
     sample_rate_hz.to_bits().hash(&mut hasher);
     directory.join(format!("{:016x}.f32", hasher.finish()))
+}
+
+/// The cache file of the reference's calibration at `key` and `pluck_position_m`.
+fn calibration_cache_file(
+    directory: &Path,
+    version: &str,
+    key: u8,
+    pluck_position_m: f64,
+    sample_rate_hz: f64,
+) -> PathBuf {
+    let point = GridPoint {
+        key,
+        velocity: 127,
+        pluck_position_m,
+    };
+    let mut hasher = DefaultHasher::new();
+    "as-played calibration".hash(&mut hasher);
+    version.hash(&mut hasher);
+    format!("{:?}", settings_for(Quality::Reference, &point)).hash(&mut hasher);
+    key.hash(&mut hasher);
+    sample_rate_hz.to_bits().hash(&mut hasher);
+    directory.join(format!("{:016x}.cents", hasher.finish()))
+}
+
+/// The calibration of a string with its offset not yet measured (what the cache fills in).
+fn calibrate_lazily(quality: Quality, key: u8, position: f64, sample_rate_hz: f64) -> Calibration {
+    let point = GridPoint {
+        key,
+        velocity: 127,
+        pluck_position_m: position,
+    };
+    let settings = settings_for(quality, &point);
+    let request = javari_core::engine::Engine::planned_strings(&settings, &[key])[0];
+    Calibration {
+        request,
+        sample_rate_hz,
+        offset_cents: 0.0,
+    }
+}
+
+fn read_cached_offset(path: &Path) -> Option<f64> {
+    std::fs::read_to_string(path).ok()?.trim().parse().ok()
+}
+
+fn write_cached_offset(path: &Path, offset_cents: f64) {
+    let temporary = path.with_extension("partial");
+    if std::fs::write(&temporary, format!("{offset_cents:e}")).is_ok() {
+        let _ = std::fs::rename(&temporary, path);
+    }
 }
 
 fn read_cached(path: &Path, samples: usize) -> Option<Vec<f64>> {
@@ -146,7 +202,50 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
         tiers.len(),
         rayon::current_num_threads()
     );
-    // One job per (tier, pluck), the reference first so that the slowest jobs start first.
+    // Each tier's calibrations, one per key and pluck position (the reference's from the cache
+    // when there), the reference's first so that the slowest jobs start first.
+    let strings: Vec<(u8, f64)> = KEYS
+        .iter()
+        .flat_map(|&key| PLUCK_POSITIONS_M.map(|position| (key, position)))
+        .collect();
+    let mut calibration_jobs: Vec<(Quality, u8, f64)> = strings
+        .iter()
+        .map(|&(key, position)| (Quality::Reference, key, position))
+        .collect();
+    for &tier in tiers {
+        calibration_jobs.extend(strings.iter().map(|&(key, position)| (tier, key, position)));
+    }
+    let calibrations: Vec<Calibration> = calibration_jobs
+        .par_iter()
+        .map(|&(quality, key, position)| {
+            if quality != Quality::Reference {
+                return calibrate(quality, key, position, sample_rate_hz);
+            }
+            let path = cache.as_ref().map(|(dir, version)| {
+                calibration_cache_file(dir, version, key, position, sample_rate_hz)
+            });
+            let mut calibration = calibrate_lazily(quality, key, position, sample_rate_hz);
+            if let Some(offset) = path.as_deref().and_then(read_cached_offset) {
+                calibration.offset_cents = offset;
+                return calibration;
+            }
+            let measured = calibrate(quality, key, position, sample_rate_hz);
+            if let Some(path) = path {
+                write_cached_offset(&path, measured.offset_cents);
+            }
+            measured
+        })
+        .collect();
+    let calibration_of = |quality: Quality, point: &GridPoint| {
+        calibration_jobs
+            .iter()
+            .position(|&(q, key, position)| {
+                q == quality && key == point.key && position == point.pluck_position_m
+            })
+            .map(|index| calibrations[index])
+            .expect("every tier's string is calibrated")
+    };
+    // One job per (tier, pluck), the reference first.
     let mut jobs: Vec<(Option<Quality>, usize)> = (0..grid.len()).map(|i| (None, i)).collect();
     for &tier in tiers {
         jobs.extend((0..grid.len()).map(|i| (Some(tier), i)));
@@ -156,7 +255,13 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
         .map(|&(tier, index)| {
             let point = &grid[index];
             match tier {
-                Some(quality) => render(quality, point, NOTE_SECONDS, sample_rate_hz),
+                Some(quality) => render_as_played(
+                    quality,
+                    point,
+                    NOTE_SECONDS,
+                    sample_rate_hz,
+                    &calibration_of(quality, point),
+                ),
                 None => {
                     let path = cache
                         .as_ref()
@@ -164,7 +269,13 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
                     if let Some(cached) = path.as_deref().and_then(|p| read_cached(p, samples)) {
                         return cached;
                     }
-                    let output = render(Quality::Reference, point, NOTE_SECONDS, sample_rate_hz);
+                    let output = render_as_played(
+                        Quality::Reference,
+                        point,
+                        NOTE_SECONDS,
+                        sample_rate_hz,
+                        &calibration_of(Quality::Reference, point),
+                    );
                     if let Some(path) = path {
                         write_cached(&path, &output);
                     }

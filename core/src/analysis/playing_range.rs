@@ -1,9 +1,12 @@
 //! The tanpura's playing range as a grid of single plucks: keys, velocities and pluck positions,
 //! each rendered as a MIDI note through the engine at a chosen tier. The bench compares every
 //! tier with the reference over the whole grid ([`full_grid`]); the tests over a few points of it.
-//! Each pluck is one voice of a fresh engine, the pickup output, 64-sample blocks.
+//! Each pluck is one voice of a fresh engine, the pickup output, 64-sample blocks; tuned by its
+//! linearisation ([`render`]) or, as `cargo xtask render` and the plugin tune it, by its
+//! sustained pitch as played ([`calibrate`], [`render_as_played`]).
 
 use crate::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
+use crate::tanpura::as_played::Calibration;
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::quality::Quality;
 use crate::tanpura::VoiceSettings;
@@ -75,8 +78,53 @@ pub fn settings_for(quality: Quality, point: &GridPoint) -> EngineSettings {
 /// Renders one pluck of the grid for `seconds` at `sample_rate_hz`: a note-on at the first
 /// sample, the string left ringing.
 pub fn render(quality: Quality, point: &GridPoint, seconds: f64, sample_rate_hz: f64) -> Vec<f64> {
+    render_tuned(quality, point, seconds, sample_rate_hz, None)
+}
+
+/// The as-played calibration of the grid's string at `key` plucked at `pluck_position_m` on
+/// `quality` (the same for every velocity: it centres velocities 40 and 110). Renders.
+pub fn calibrate(
+    quality: Quality,
+    key: u8,
+    pluck_position_m: f64,
+    sample_rate_hz: f64,
+) -> Calibration {
+    let point = GridPoint {
+        key,
+        velocity: 127,
+        pluck_position_m,
+    };
+    let settings = settings_for(quality, &point);
+    let request = Engine::planned_strings(&settings, &[key])
+        .into_iter()
+        .next()
+        .expect("every key of the grid is playable");
+    Calibration::measure(&request, sample_rate_hz)
+}
+
+/// [`render`] with the string tuned as played by `calibration` (from [`calibrate`]).
+pub fn render_as_played(
+    quality: Quality,
+    point: &GridPoint,
+    seconds: f64,
+    sample_rate_hz: f64,
+    calibration: &Calibration,
+) -> Vec<f64> {
+    render_tuned(quality, point, seconds, sample_rate_hz, Some(calibration))
+}
+
+fn render_tuned(
+    quality: Quality,
+    point: &GridPoint,
+    seconds: f64,
+    sample_rate_hz: f64,
+    calibration: Option<&Calibration>,
+) -> Vec<f64> {
     const BLOCK: usize = 64;
     let mut engine = Engine::new(&settings_for(quality, point), sample_rate_hz, 1);
+    if let Some(calibration) = calibration {
+        engine.set_calibration(calibration);
+    }
     let samples = (seconds * sample_rate_hz).round() as usize;
     let mut output = Vec::with_capacity(samples);
     let mut block = [0.0f32; BLOCK];
