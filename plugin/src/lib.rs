@@ -15,10 +15,12 @@
 //! (`javari_core::bowed::instrument` documents that mapping): CCs, channel and per-note pressure
 //! and pitch bend reach it too.
 //!
-//! Towards the host: the latency of the current quality tier (the FD tiers' decimator delay,
-//! none for the modal tiers) is reported at activation and again from `process` whenever the tier
-//! changes (nice-plug passes that on as CLAP `latency.changed` after a restart, VST3
-//! `restartComponent(kLatencyChanged)`); a state blob is repaired before it loads ([`state`]);
+//! Towards the host: one latency at every quality tier and for both instruments (the FD tiers'
+//! decimator delay, 29 samples; the engine delays the modal tiers and the bowed string to
+//! match, `Engine::latency_samples`), reported at activation and never changed, so switching
+//! tiers needs no restart (and nice-plug 0.4.2's CLAP wrapper never gets the chance to call
+//! `latency.changed` outside `activate`, which clap-validator caught); a state blob is repaired
+//! before it loads ([`state`]);
 //! `process` runs with subnormals flushed to zero (`javari_core::denormals`).
 //!
 //! Each string is tuned by its sustained pitch as played once [`tuning_worker`] has measured
@@ -227,8 +229,6 @@ impl Plugin for Javari {
             return ProcessStatus::Error("process called before activate");
         };
         engine.set_settings(&self.params.engine_settings(&self.factory));
-        // The wrapper tells the host only when the value changes (a change of tier).
-        context.set_latency_samples(latency_in_samples(engine));
         engine.set_host_tempo(context.transport().tempo);
 
         self.events.clear();

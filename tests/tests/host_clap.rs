@@ -221,8 +221,16 @@ fn clap_plays_in_tune_at_several_rates_and_block_sizes() {
             note_at,
             0.6,
         );
-        assert!(left.iter().all(|x| x.is_finite()), "non-finite sample");
-        assert_eq!(left, right, "both channels carry the string");
+        assert!(
+            left.iter().chain(&right).all(|x| x.is_finite()),
+            "non-finite sample"
+        );
+        // Stereo: the string panned by its pitch; the mid signal is the mono output.
+        let left: Vec<f32> = left
+            .iter()
+            .zip(&right)
+            .map(|(l, r)| 0.5 * (l + r))
+            .collect();
         assert!(peak(&left[..note_at]) == 0.0, "silent before the note");
         let ringing = &left[(0.1 * sample_rate) as usize..];
         let level = peak(ringing);
@@ -429,11 +437,13 @@ fn engine_latency(quality: Quality) -> u32 {
         .round() as u32
 }
 
-/// The plugin reports 0 samples at the modal tiers and the decimator's delay at the FD tiers.
-/// Automating the tier while processing asks the host for a restart; on reactivation the
-/// plugin calls `latency.changed`, and `latency.get` returns the new tier's latency.
+/// The plugin reports the same latency at every tier (the FD tiers' decimator delay; the modal
+/// tiers' strings are delayed to it): automating the tier while processing asks the host for
+/// nothing, neither a restart nor `latency.changed` (nice-plug 0.4.2 would call the latter
+/// outside `activate` for a change that reaches it after a deactivation, which the CLAP spec
+/// forbids), and `latency.get` stays the engine's latency.
 #[test]
-fn clap_reports_the_tier_latency_and_its_changes() {
+fn clap_reports_one_latency_at_every_tier() {
     let entry = load_entry();
     let mut instance = instantiate(entry);
     let quality = parameter_id(&mut instance, "Quality");
@@ -448,37 +458,30 @@ fn clap_reports_the_tier_latency_and_its_changes() {
         instance.access_handler(|host| host.latency_changes.get())
     };
 
-    let studio = engine_latency(Quality::Studio);
-    let reference = engine_latency(Quality::Reference);
-    println!("latency: studio {studio} samples, reference {reference} samples at 44.1 kHz");
-    assert!(
-        studio > 0 && reference > 0,
-        "the FD tiers have a decimator delay"
-    );
-    assert_eq!(engine_latency(Quality::Live), 0);
+    let expected = engine_latency(Quality::Reference);
+    println!("latency: {expected} samples at 44.1 kHz, every tier");
+    assert!(expected > 0, "the FD tiers have a decimator delay");
+    for tier in Quality::ALL {
+        assert_eq!(engine_latency(tier), expected, "{tier:?}");
+    }
 
     let rate = 44_100.0;
-    play(&mut instance, rate, 64, 57, 0.5, 0, 0.02);
+    // The first activation reports the latency: nice-plug asks for one restart to do so (from a
+    // main-thread task, which the host runs during a later call), the only one.
+    let mut restarts = 0;
+    for _ in 0..3 {
+        play(&mut instance, rate, 64, 57, 0.5, 0, 0.02);
+        restarts += u32::from(restart_requested(&instance));
+    }
+    assert!(restarts <= 1, "{restarts} restarts to report one latency");
+    let reported_changes = changes(&instance);
     assert_eq!(
         latency.get(&instance.plugin_handle()),
-        0,
+        expected,
         "live, the default"
     );
-    assert!(!restart_requested(&instance));
-    assert_eq!(changes(&instance), 0);
-
     // (CLAP plain value of an enum parameter: its index. Draft 0, live 1, studio 2, reference 3.)
-    // A change of tier that keeps the latency (studio and reference both decimate to about the
-    // same delay) asks for nothing.
-    let mut reported = 0;
-    let mut expected_changes = 0;
-    for (index, expected) in [
-        (2.0, studio),
-        (3.0, reference),
-        (1.0, 0),
-        (0.0, 0),
-        (3.0, reference),
-    ] {
+    for index in [2.0, 3.0, 1.0, 0.0, 3.0] {
         play_automated(
             &mut instance,
             rate,
@@ -487,18 +490,13 @@ fn clap_reports_the_tier_latency_and_its_changes() {
             &[(100, quality, index)],
             0.02,
         );
-        let changed = expected != reported;
-        assert_eq!(
-            restart_requested(&instance),
-            changed,
+        assert!(
+            !restart_requested(&instance),
             "tier {index}: restart request"
         );
-        // The host restarts the plugin: the reactivation reports the change.
-        play(&mut instance, rate, 64, 57, 0.5, 0, 0.02);
-        expected_changes += u32::from(changed);
         assert_eq!(
             changes(&instance),
-            expected_changes,
+            reported_changes,
             "tier {index}: latency.changed"
         );
         assert_eq!(
@@ -506,13 +504,7 @@ fn clap_reports_the_tier_latency_and_its_changes() {
             expected,
             "tier {index}"
         );
-        assert!(
-            !restart_requested(&instance),
-            "tier {index}: no further restart"
-        );
-        reported = expected;
     }
-    assert_eq!(expected_changes, 3);
 }
 
 /// Blobs a host might hand over that are not a Javari state: the load is refused or repaired,

@@ -369,8 +369,16 @@ fn vst3_plays_in_tune_at_several_rates_and_block_sizes() {
             note_at,
             0.6,
         );
-        assert!(left.iter().all(|x| x.is_finite()), "non-finite sample");
-        assert_eq!(left, right);
+        assert!(
+            left.iter().chain(&right).all(|x| x.is_finite()),
+            "non-finite sample"
+        );
+        // Stereo: the string panned by its pitch; the mid signal is the mono output.
+        let left: Vec<f32> = left
+            .iter()
+            .zip(&right)
+            .map(|(l, r)| 0.5 * (l + r))
+            .collect();
         assert_eq!(peak(&left[..note_at]), 0.0, "silent before the note");
         let ringing = &left[(0.1 * sample_rate) as usize..];
         let level = peak(ringing);
@@ -459,11 +467,11 @@ fn parameter_id(component: &ComPtr<IComponent>, title: &str) -> ParamID {
     }
 }
 
-/// The plugin reports 0 samples at the modal tiers and the decimator's delay at the FD tiers,
-/// and asks the host to restart with `kLatencyChanged` when automation changes the tier's
-/// latency while it processes.
+/// The plugin reports the same latency at every tier (the FD tiers' decimator delay; the modal
+/// tiers' strings are delayed to it), so automating the tier while it processes never asks the
+/// host to restart with `kLatencyChanged`.
 #[test]
-fn vst3_reports_the_tier_latency_and_its_changes() {
+fn vst3_reports_one_latency_at_every_tier() {
     let module = module();
     let (component, processor) = module.instantiate();
     let handler = ComWrapper::new(ComponentHandler::default());
@@ -478,19 +486,27 @@ fn vst3_reports_the_tier_latency_and_its_changes() {
     let quality = parameter_id(&component, "Quality");
     let take_restart_flags = || handler.restart_flags.swap(0, Ordering::SeqCst);
     let latency = || unsafe { processor.getLatencySamples() };
+    let expected = engine_latency(Quality::Reference);
+    assert!(expected > 0, "the FD tiers have a decimator delay");
 
-    play(&component, &processor, 44_100.0, 64, 57, 0, 0.02);
-    assert_eq!(latency(), 0, "live, the default");
-    assert_eq!(take_restart_flags(), 0);
+    // The first activation reports the latency (with one kLatencyChanged restart at most, from
+    // a main-thread task the host may run during a later call).
+    let mut restarts = 0;
+    for _ in 0..3 {
+        play(&component, &processor, 44_100.0, 64, 57, 0, 0.02);
+        restarts += u32::from(take_restart_flags() & RestartFlags_::kLatencyChanged != 0);
+    }
+    assert!(restarts <= 1, "{restarts} restarts to report one latency");
+    assert_eq!(latency(), expected, "live, the default");
 
     // Normalised enum values: draft 0, live 1/3, studio 2/3, reference 1.
-    let mut reported = 0;
-    for (tier, value, expected) in [
-        (Quality::Studio, 2.0 / 3.0, engine_latency(Quality::Studio)),
-        (Quality::Live, 1.0 / 3.0, 0),
-        (Quality::Reference, 1.0, engine_latency(Quality::Reference)),
-        (Quality::Draft, 0.0, 0),
+    for (tier, value) in [
+        (Quality::Studio, 2.0 / 3.0),
+        (Quality::Live, 1.0 / 3.0),
+        (Quality::Reference, 1.0),
+        (Quality::Draft, 0.0),
     ] {
+        assert_eq!(engine_latency(tier), expected, "{tier:?}");
         play_automated(
             &component,
             &processor,
@@ -505,14 +521,11 @@ fn vst3_reports_the_tier_latency_and_its_changes() {
             latency()
         );
         assert_eq!(latency(), expected, "{tier:?}");
-        assert!(expected > 0 || tier.oversample() == 1, "{tier:?}");
-        let latency_changed = flags & RestartFlags_::kLatencyChanged != 0;
         assert_eq!(
-            latency_changed,
-            expected != reported,
+            flags & RestartFlags_::kLatencyChanged,
+            0,
             "{tier:?}: flags {flags}"
         );
-        reported = expected;
     }
     unsafe {
         controller.setComponentHandler(std::ptr::null_mut());

@@ -365,9 +365,9 @@ pub fn to_markdown(results: &[TierOverGrid]) -> String {
         let pitch = reference.sustained_cents();
         let _ = writeln!(
             text,
-            "\nThe reference itself against the keys' nominal pitches (every tier is tuned so that \
-             its string, linearised about its rest state, has the nominal pitch): its sustained \
-             pitch is off by {:.2} cents at worst ({}), {:.2} cents median.",
+            "\nThe reference itself against the keys' nominal pitches (every tier is tuned as \
+             played: its string's sustained pitches at velocities 40 and 110 centred on the \
+             note): its sustained pitch is off by {:.2} cents at worst ({}), {:.2} cents median.",
             pitch.worst,
             pitch.worst_at.label(),
             pitch.median

@@ -22,8 +22,13 @@
 //! - the boundary with the host: settings pass through [`EngineSettings::clamped`] and events
 //!   through [`EngineEvent::sanitised`], so a non-finite or out-of-range value from automation
 //!   or MIDI is clamped (NaN takes the default) before it reaches a string;
-//! - the output latency a host must compensate ([`Engine::latency_samples`]): the FD tiers'
-//!   decimator delay, none for the modal tiers and the bowed string.
+//! - the output latency a host must compensate ([`Engine::latency_samples`]): the same at every
+//!   tier and for both instruments, the FD tiers' decimator delay (29 samples), with the modal
+//!   tiers' strings and the bowed string delayed to match ([`OutputDelay`]). A latency that
+//!   followed the tier would make the host restart the plugin at every switch, and nice-plug
+//!   0.4.2's CLAP wrapper reports a change that reaches it just after the host deactivated the
+//!   plugin with `latency.changed` outside `activate`, which the CLAP spec forbids
+//!   (clap-validator's parameter tests failed on it); 0.66 ms for the modal tiers buys neither.
 //!
 //! Lifecycle (design.md): [`Engine::new`] allocates every voice; [`Engine::process`],
 //! [`Engine::set_settings`], [`Engine::set_host_tempo`] and [`Engine::reset`] never allocate,
@@ -42,6 +47,7 @@ use crate::bowed::{BowedEvent, BowedInstrument, BowedPlayerSettings, StringConst
 use crate::tanpura::as_played::{AsPlayedTuning, Calibration, CalibrationRequest, NOTE_VELOCITIES};
 use crate::tanpura::body::{Body, TANPURA_BODY};
 use crate::tanpura::excitation::Pluck;
+use crate::tanpura::quality::Quality;
 use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
 use drone::{string_ratios, DroneSequencer, DroneSettings};
 use smoothing::Ramp;
@@ -53,6 +59,48 @@ use smoothing::Ramp;
 /// finger) on the reference string peaks at about 0.49 N at the nut, so 2 N puts it near
 /// −12 dBFS, which leaves headroom for several strings ringing together.
 pub const NEWTONS_AT_FULL_SCALE: f64 = 2.0;
+/// Longest output delay an [`OutputDelay`] holds, samples.
+const MAX_OUTPUT_DELAY: usize = 64;
+
+/// A fixed delay of up to [`MAX_OUTPUT_DELAY`] samples (a ring buffer), to bring a voice whose
+/// own latency is lower up to the engine's uniform latency. Allocation-free.
+#[derive(Debug, Clone)]
+struct OutputDelay {
+    buffer: [f32; MAX_OUTPUT_DELAY],
+    length: usize,
+    position: usize,
+}
+
+impl OutputDelay {
+    fn new(length: usize) -> Self {
+        Self {
+            buffer: [0.0; MAX_OUTPUT_DELAY],
+            length: length.min(MAX_OUTPUT_DELAY),
+            position: 0,
+        }
+    }
+
+    /// Changes the delay (and clears it: what it held belongs to the old latency).
+    fn set_length(&mut self, length: usize) {
+        *self = Self::new(length);
+    }
+
+    fn clear(&mut self) {
+        self.buffer.fill(0.0);
+    }
+
+    /// Pushes `value` in and returns the value `length` samples old.
+    fn process(&mut self, value: f32) -> f32 {
+        if self.length == 0 {
+            return value;
+        }
+        let delayed = self.buffer[self.position];
+        self.buffer[self.position] = value;
+        self.position = (self.position + 1) % self.length;
+        delayed
+    }
+}
+
 /// Samples between two updates of the strings' smoothed settings.
 pub const CONTROL_INTERVAL: u64 = 32;
 /// Time a continuous setting takes to reach a new value, s.
@@ -385,6 +433,8 @@ struct Slot {
     level_factor: f64,
     /// Where the string sits in the stereo image, −1 (left) to 1 (right), before the width.
     pan: f32,
+    /// Brings the string's own latency (its tier's) up to the engine's.
+    delay: OutputDelay,
     /// Absolute sample of the last pluck.
     plucked_at: u64,
     /// Peak-following level of the scaled output, for stealing.
@@ -401,10 +451,11 @@ fn run_slot(slot: &mut Slot, release: f32, length: usize, mut emit: impl FnMut(u
     let scale = (slot.level_factor / NEWTONS_AT_FULL_SCALE) as f32;
     let mut level = slot.level;
     for index in 0..length {
-        let value = slot.voice.next_sample() * scale;
+        let value = slot.delay.process(slot.voice.next_sample() * scale);
         if !value.is_finite() {
             // Fail soft: a voice that blew up is silenced, never passed on.
             slot.voice.reset();
+            slot.delay.clear();
             level = 0.0;
             break;
         }
@@ -486,6 +537,10 @@ pub struct Engine {
     level_release: f32,
     /// One bowed instrument per string kind, built up front.
     bowed: Vec<BowedInstrument>,
+    /// The engine's output latency, whole samples (see [`Engine::latency_samples`]).
+    latency: usize,
+    /// Brings the bowed string (no latency of its own) up to it.
+    bowed_delay: OutputDelay,
     /// The bow controls last applied from the settings (knobs), to apply only their changes.
     applied_bow_controls: Option<(f64, f64, f64)>,
     /// One buffer per voice for [`Engine::process_with`] (empty until it is used).
@@ -524,7 +579,7 @@ impl Engine {
     pub fn new(settings: &EngineSettings, sample_rate_hz: f64, voice_count: usize) -> Self {
         let settings = &settings.clamped();
         let voice = settings.voice;
-        let slots = (0..voice_count.max(1))
+        let slots: Vec<Slot> = (0..voice_count.max(1))
             .map(|_| Slot {
                 voice: TanpuraVoice::new(&voice, sample_rate_hz),
                 key: None,
@@ -532,6 +587,7 @@ impl Engine {
                 tuned_hz: voice.fundamental_hz,
                 level_factor: 1.0,
                 pan: 0.0,
+                delay: OutputDelay::new(0),
                 plucked_at: 0,
                 level: 0.0,
             })
@@ -540,6 +596,14 @@ impl Engine {
             (SMOOTHING_TIME_S * sample_rate_hz / CONTROL_INTERVAL as f64).ceil() as u32;
         let gain_steps = (SMOOTHING_TIME_S * sample_rate_hz).ceil() as u32;
         let gain = db_to_amplitude(settings.output_gain_db);
+        // The largest latency of any tier: the FD tiers' decimator delay.
+        let latency = slots.first().map_or(0.0, |slot: &Slot| {
+            Quality::ALL
+                .iter()
+                .map(|&quality| slot.voice.latency_samples_at(quality))
+                .fold(0.0, f64::max)
+        });
+        let latency = (latency.round() as usize).min(MAX_OUTPUT_DELAY);
         let mut engine = Self {
             sample_rate_hz,
             slots,
@@ -570,6 +634,8 @@ impl Engine {
                 })
                 .collect(),
             applied_bow_controls: None,
+            latency,
+            bowed_delay: OutputDelay::new(latency),
             scratch: Vec::new(),
             body: Body::new(&TANPURA_BODY, sample_rate_hz),
             side_body: Body::new(&TANPURA_BODY, sample_rate_hz),
@@ -687,16 +753,11 @@ impl Engine {
         &self.target
     }
 
-    /// The output latency of the current settings, samples at the output rate: the decimator's
-    /// delay at an FD tier, 0 at a modal tier and for the bowed string. (A string still ringing
-    /// at its old tier after a switch keeps that tier's delay until its next pluck.)
+    /// The output latency, samples at the output rate: the same whatever the tier or the
+    /// instrument (the FD tiers' decimator delay, rounded to whole samples; the other voices are
+    /// delayed to match).
     pub fn latency_samples(&self) -> f64 {
-        match self.target.instrument {
-            Instrument::Bowed => 0.0,
-            Instrument::Tanpura => self.slots[0]
-                .voice
-                .latency_samples_at(self.target.voice.quality),
-        }
+        self.latency as f64
     }
 
     /// Adds a string's as-played calibration (measured off the audio thread with
@@ -782,6 +843,7 @@ impl Engine {
         self.current_voice = voice;
         for slot in &mut self.slots {
             slot.voice.reset();
+            slot.delay.clear();
             slot.key = None;
             slot.level = 0.0;
             slot.plucked_at = 0;
@@ -794,6 +856,7 @@ impl Engine {
         for instrument in &mut self.bowed {
             instrument.reset();
         }
+        self.bowed_delay.clear();
         self.applied_bow_controls = None;
         self.apply_bowed_settings();
     }
@@ -895,13 +958,15 @@ impl Engine {
         let width = self.target.stereo_width as f32;
         if self.target.instrument == Instrument::Bowed {
             let scale = 1.0 / BOWED_NEWTONS_AT_FULL_SCALE;
-            let bowed = self.bowed_mut();
+            let index = self.target.bowed.string.index();
+            let (bowed, delay) = (&mut self.bowed[index], &mut self.bowed_delay);
             for sample in output.iter_mut() {
-                let value = (bowed.next_sample() * scale) as f32;
+                let value = delay.process((bowed.next_sample() * scale) as f32);
                 if !value.is_finite() {
                     // Fail soft, as for a tanpura voice: a bowed string that blew up is
                     // silenced and restarts at rest.
                     bowed.reset();
+                    delay.clear();
                     break;
                 }
                 *sample += value;
@@ -1089,6 +1154,7 @@ impl Engine {
                 self.drone.all_notes_off();
                 for slot in &mut self.slots {
                     slot.voice.reset();
+                    slot.delay.clear();
                     slot.key = None;
                     slot.level = 0.0;
                 }
@@ -1220,6 +1286,7 @@ impl Engine {
         if slot.key != Some(key) || slot.fundamental_hz != fundamental_hz {
             // A stolen string is stopped first: its old vibration belongs to another tuning.
             slot.voice.reset();
+            slot.delay.clear();
             slot.key = Some(key);
             slot.fundamental_hz = fundamental_hz;
         }
@@ -1228,6 +1295,11 @@ impl Engine {
         slot.level_factor = pitch_level_factor(fundamental_hz) * level;
         // Also brings a re-plucked string to the current quality tier.
         slot.voice.set_settings(&string_settings);
+        let own_latency = slot.voice.latency_samples().round() as usize;
+        let padding = self.latency.saturating_sub(own_latency);
+        if slot.delay.length != padding {
+            slot.delay.set_length(padding);
+        }
         let mut pluck = self.target.pluck;
         pluck.amplitude_m *= f64::from(velocity.clamp(0.0, 1.0));
         slot.voice.pluck(&pluck);
