@@ -303,7 +303,7 @@ fn non_finite_and_out_of_range_values_are_clamped() {
 #[test]
 fn latency_is_the_same_at_every_tier_and_the_modal_tiers_are_delayed_to_it() {
     let tanpura_settings = settings(Instrument::Tanpura);
-    let mut settings = tanpura_settings.clone();
+    let mut settings = tanpura_settings;
     let mut engine = Engine::new(&settings, 44_100.0, 2);
     let mut latency = |quality: Quality, instrument: Instrument| {
         settings.voice.quality = quality;
@@ -329,7 +329,7 @@ fn latency_is_the_same_at_every_tier_and_the_modal_tiers_are_delayed_to_it() {
     }
     let delay = reference as usize;
     for quality in [Quality::Draft, Quality::Live] {
-        let mut modal = tanpura_settings.clone();
+        let mut modal = tanpura_settings;
         modal.voice.quality = quality;
         let mut engine = Engine::new(&modal, 44_100.0, 1);
         let mut output = vec![0.0f32; 256];
