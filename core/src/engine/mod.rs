@@ -539,6 +539,8 @@ pub struct Engine {
     bowed: Vec<BowedInstrument>,
     /// The engine's output latency, whole samples (see [`Engine::latency_samples`]).
     latency: usize,
+    /// The slot [`Engine::control_tick`] looks at first for a string to retune.
+    retune_cursor: usize,
     /// Brings the bowed string (no latency of its own) up to it.
     bowed_delay: OutputDelay,
     /// The bow controls last applied from the settings (knobs), to apply only their changes.
@@ -635,6 +637,7 @@ impl Engine {
                 .collect(),
             applied_bow_controls: None,
             latency,
+            retune_cursor: 0,
             bowed_delay: OutputDelay::new(latency),
             scratch: Vec::new(),
             body: Body::new(&TANPURA_BODY, sample_rate_hz),
@@ -853,6 +856,7 @@ impl Engine {
         self.side_body.reset();
         self.clock = 0;
         self.next_control_tick = 0;
+        self.retune_cursor = 0;
         for instrument in &mut self.bowed {
             instrument.reset();
         }
@@ -1081,27 +1085,38 @@ impl Engine {
                     pitch_level_factor(slot.fundamental_hz) * drone_strings[index].level_factor();
             }
         }
-        if settings == self.current_voice {
-            return;
-        }
         self.current_voice = settings;
-        for slot in &mut self.slots {
+        // At most one ringing string takes the new settings per control tick, the next in turn
+        // whose settings differ: retuning a string (a new rest state and its linearised
+        // fundamental) costs about a fifth of a 64-sample block's deadline at the live tier
+        // (309 µs, studio 739 µs), so retuning every string at every tick of a glide of k_b or
+        // the thread missed the deadline several times over (the soak). With eight strings
+        // ringing each follows a glide every eight ticks (5.8 ms at 44.1 kHz) and reaches the
+        // target at most that late.
+        let count = self.slots.len();
+        for step in 0..count {
+            let index = (self.retune_cursor + step) % count;
+            let slot = &mut self.slots[index];
+            if !slot.voice.is_active() {
+                // A silent string takes the settings when it is next plucked
+                // (`pluck_string`).
+                continue;
+            }
             let mut string_settings = settings;
             string_settings.fundamental_hz = slot.tuned_hz;
             if let Some(StringKey::Drone(index)) = slot.key {
                 string_settings.thread_position_m += drone_strings[index].thread_offset_m;
             }
             let mut string_settings = string_settings.clamped();
-            if !slot.voice.is_active() {
-                // A silent string takes the settings when it is next plucked
-                // (`pluck_string`): retuning it now, every control tick of a glide, cost a
-                // static solve per silent string (the soak's deadline misses).
-                continue;
-            }
             // A voice switching tier restarts at rest (`TanpuraVoice::set_settings`), so a
             // ringing string keeps its tier; the new one applies from its next pluck.
             string_settings.quality = slot.voice.settings().quality;
+            if string_settings == *slot.voice.settings() {
+                continue;
+            }
             slot.voice.set_settings(&string_settings);
+            self.retune_cursor = (index + 1) % count;
+            break;
         }
     }
 

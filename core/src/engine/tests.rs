@@ -531,3 +531,38 @@ fn the_first_drone_string_sounds_on_the_left_and_the_last_on_the_right() {
     assert_eq!(drone_string_pan(3, 4), 1.0);
     assert_eq!(drone_string_pan(1, 5), -0.5);
 }
+
+#[test]
+fn a_glide_retunes_one_ringing_string_per_control_tick_and_every_string_reaches_the_target() {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Draft;
+    let mut engine = Engine::new(&settings, RATE, 4);
+    let notes: Vec<TimedEvent> = [45u8, 50, 55, 60]
+        .iter()
+        .enumerate()
+        .map(|(index, &note)| note_on(index, note))
+        .collect();
+    run(&mut engine, &notes, 64);
+    assert_eq!(engine.active_voices(), 4);
+    settings.voice.thread_position_m = 0.042;
+    engine.set_settings(&settings);
+    let threads = |engine: &Engine| -> Vec<f64> {
+        engine
+            .slots
+            .iter()
+            .map(|slot| slot.voice.settings().thread_position_m)
+            .collect()
+    };
+    let ticks = (SMOOTHING_TIME_S * RATE / CONTROL_INTERVAL as f64).ceil() as usize + 4;
+    let mut before = threads(&engine);
+    for tick in 0..ticks {
+        run(&mut engine, &[], CONTROL_INTERVAL as usize);
+        let after = threads(&engine);
+        let changed = before.iter().zip(&after).filter(|(a, b)| a != b).count();
+        assert!(changed <= 1, "tick {tick}: {changed} strings retuned");
+        before = after;
+    }
+    for (index, thread) in threads(&engine).iter().enumerate() {
+        assert!((thread - 0.042).abs() < 1e-12, "string {index}: {thread}");
+    }
+}
