@@ -69,6 +69,12 @@ pub struct RenderArgs {
     /// Seconds rendered after the last event (0 to 60).
     #[arg(long, value_name = "S", default_value_t = 3.0, value_parser = number_in(0.0, 60.0))]
     tail_seconds: f64,
+    /// Sets one preset key for this render, as written in a preset file (repeatable; every key
+    /// of `presets/*.toml`, e.g. `--set drone_pattern=five --set reference_a4_hz=432
+    /// --set drone_string_fine_tune_cents=[0,-2] --set stereo_width=0.8`); applied after
+    /// `--preset`.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = key_value)]
+    set: Vec<(String, String)>,
     /// Also write a spectrogram of the result as a PNG.
     #[arg(long, value_name = "FILE.png")]
     plot: Option<PathBuf>,
@@ -97,6 +103,7 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         block_size,
         quality,
         tail_seconds: tail_s,
+        set,
         plot,
         jobs,
         max_seconds,
@@ -130,9 +137,17 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         .as_ref()
         .map_or_else(Score::demo, |read| read.score.clone());
     let out = out.unwrap_or(default_out);
-    let mut settings = match &preset_path {
-        Some(path) => Preset::load(path)?.settings,
-        None => EngineSettings::default(),
+    let preset = match &preset_path {
+        Some(path) => Preset::load(path)?,
+        None => Preset {
+            name: "default".to_string(),
+            settings: EngineSettings::default(),
+        },
+    };
+    let mut settings = if set.is_empty() {
+        preset.settings
+    } else {
+        preset.with_overrides(&set)?.settings
     };
     if let Some(quality) = quality {
         settings.voice.quality = quality;
@@ -206,6 +221,16 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         eprintln!("wrote the spectrogram {}", plot.display());
     }
     Ok(())
+}
+
+/// A `--set` argument: `KEY=VALUE`.
+fn key_value(text: &str) -> Result<(String, String), String> {
+    match text.split_once('=') {
+        Some((key, value)) if !key.trim().is_empty() => {
+            Ok((key.trim().to_string(), value.trim().to_string()))
+        }
+        _ => Err(format!("`{text}` is not KEY=VALUE (a preset key, e.g. drone_pattern=five)")),
+    }
 }
 
 /// Refuses a render longer than `max_seconds` or than a WAV file holds, saying where a MIDI

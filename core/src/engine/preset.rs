@@ -644,6 +644,24 @@ impl Preset {
         Ok(preset)
     }
 
+    /// This preset with some keys set anew, each `(key, value)` written as in a preset file
+    /// (`drone_pattern`, `five`; quotes around a word may be left out): what `cargo xtask render
+    /// --set key=value` plays. An unknown key or a bad value is an error naming it, as in a
+    /// file, with `--set` as the file's name.
+    pub fn with_overrides(&self, overrides: &[(String, String)]) -> Result<Self, PresetError> {
+        let mut table: toml::Table =
+            toml::from_str(&self.to_text()).expect("to_text writes a TOML table");
+        for (key, value) in overrides {
+            let value = toml::from_str::<toml::Table>(&format!("value = {value}"))
+                .ok()
+                .and_then(|mut parsed| parsed.remove("value"))
+                .unwrap_or_else(|| toml::Value::String(value.trim().to_string()));
+            table.insert(key.trim().to_string(), value);
+        }
+        let text = toml::to_string(&table).expect("a table of plain values");
+        Self::parse(&text, "--set")
+    }
+
     /// The preset as TOML text that [`Preset::parse`] reads back to the same settings (every
     /// key, in the order of the table above).
     pub fn to_text(&self) -> String {
@@ -705,6 +723,40 @@ impl Preset {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn overrides_set_keys_and_name_a_bad_one() {
+        let preset = Preset {
+            name: "base".to_string(),
+            settings: EngineSettings::default(),
+        };
+        let set = |pairs: &[(&str, &str)]| {
+            let pairs: Vec<(String, String)> = pairs
+                .iter()
+                .map(|(key, value)| (key.to_string(), value.to_string()))
+                .collect();
+            preset.with_overrides(&pairs)
+        };
+        let changed = set(&[
+            ("drone_pattern", "five"),
+            ("reference_a4_hz", "432"),
+            ("drone_string_level_db", "[0, -3]"),
+            ("tune_as_played", "false"),
+            ("tanpura_output", "\"radiated\""),
+        ])
+        .unwrap();
+        assert_eq!(changed.settings.drone.pattern, DronePattern::Five);
+        assert_eq!(changed.settings.tuning.a4_hz, 432.0);
+        assert_eq!(changed.settings.drone.strings[1].level_db, -3.0);
+        assert!(!changed.settings.tuning.as_played);
+        assert_eq!(changed.settings.tanpura_output, TanpuraOutput::Radiated);
+        assert_eq!(changed.settings.voice, preset.settings.voice);
+        let error = set(&[("reference_a4_hz", "500")]).unwrap_err();
+        assert_eq!((error.file.as_str(), error.field.as_str()), ("--set", "reference_a4_hz"));
+        assert!(error.expected.contains("415"), "{error}");
+        let error = set(&[("drone_strings", "4")]).unwrap_err().to_string();
+        assert!(error.contains("drone_strings"), "{error}");
+    }
 
     #[test]
     fn round_trip_through_text() {
