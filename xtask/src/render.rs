@@ -229,7 +229,9 @@ fn key_value(text: &str) -> Result<(String, String), String> {
         Some((key, value)) if !key.trim().is_empty() => {
             Ok((key.trim().to_string(), value.trim().to_string()))
         }
-        _ => Err(format!("`{text}` is not KEY=VALUE (a preset key, e.g. drone_pattern=five)")),
+        _ => Err(format!(
+            "`{text}` is not KEY=VALUE (a preset key, e.g. drone_pattern=five)"
+        )),
     }
 }
 

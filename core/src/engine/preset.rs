@@ -752,7 +752,10 @@ mod tests {
         assert_eq!(changed.settings.tanpura_output, TanpuraOutput::Radiated);
         assert_eq!(changed.settings.voice, preset.settings.voice);
         let error = set(&[("reference_a4_hz", "500")]).unwrap_err();
-        assert_eq!((error.file.as_str(), error.field.as_str()), ("--set", "reference_a4_hz"));
+        assert_eq!(
+            (error.file.as_str(), error.field.as_str()),
+            ("--set", "reference_a4_hz")
+        );
         assert!(error.expected.contains("415"), "{error}");
         let error = set(&[("drone_strings", "4")]).unwrap_err().to_string();
         assert!(error.contains("drone_strings"), "{error}");
