@@ -11,11 +11,13 @@
 //!   named in a warning;
 //! - the rendered length is announced before the work starts; a score longer than
 //!   `--max-seconds` (default one hour) is refused with where its time goes, never cut;
-//! - samples are streamed to a temporary file beside the output (`.NAME.partial-XXXXXX`, hidden),
-//!   block by block, so memory does not grow with the length; the file is renamed onto the
-//!   output only when the render succeeded, so a failed or interrupted render never leaves a
-//!   partial WAV or touches the previous one (a render killed outright can leave the hidden
-//!   temporary file, never a damaged output);
+//! - samples are streamed block by block to a file without a name in the output's directory
+//!   (Linux `O_TMPFILE`), so memory does not grow with the length; only when the render
+//!   succeeded is the file given a name and renamed onto the output, so a failed, interrupted or
+//!   killed render (even by SIGKILL) leaves nothing on disk and the previous output untouched.
+//!   Where the file system cannot make an unnamed file, a hidden named one
+//!   (`.NAME.partial-XXXXXX`) is used instead, removed on any failure; only a render killed
+//!   outright can then leave it behind, never a damaged output;
 //! - a render that is silent from start to end is an error rather than a quiet WAV of zeros.
 //!
 //! Progress goes to stderr: an indicatif bar on a terminal, a plain line every 10 % otherwise (a
@@ -304,13 +306,65 @@ fn check_playable_notes(
     Ok(())
 }
 
-/// A WAV file being written: samples go to a temporary file in the output's directory
-/// (`.NAME.partial-XXXXXX`), renamed onto the output by [`PendingWav::commit`]. Dropped without a
-/// commit (an error, a panic), the temporary file is removed and the output is untouched.
+/// Where a [`PendingWav`]'s samples are until the commit.
+enum Temporary {
+    /// A file without a name (`O_TMPFILE`): nothing to clean up, whatever ends the process. The
+    /// handle keeps the file open for the commit's `linkat`.
+    #[cfg(target_os = "linux")]
+    Unnamed {
+        handle: std::fs::File,
+        directory: PathBuf,
+    },
+    /// A hidden named file, removed when dropped without a commit.
+    Named(tempfile::TempPath),
+}
+
+/// A WAV file being written (see the module doc): samples go to an unnamed file in the output's
+/// directory (or a hidden named one), which [`PendingWav::commit`] names and renames onto the
+/// output. Dropped without a commit (an error, a panic), nothing is left and the output is
+/// untouched; killed, the unnamed file vanishes with the process.
 struct PendingWav {
     writer: hound::WavWriter<BufWriter<std::fs::File>>,
-    temporary: tempfile::TempPath,
+    temporary: Temporary,
     out: PathBuf,
+    name: String,
+}
+
+/// A file without a name in `directory`, with the permissions any new file gets.
+#[cfg(target_os = "linux")]
+fn unnamed_file(directory: &Path) -> Option<std::fs::File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .mode(0o666)
+        .custom_flags(libc::O_TMPFILE)
+        .open(directory)
+        .ok()
+}
+
+/// Gives the unnamed file behind `handle` the name `target` (`linkat` of `/proc/self/fd/N`).
+#[cfg(target_os = "linux")]
+fn name_unnamed_file(handle: &std::fs::File, target: &Path) -> std::io::Result<()> {
+    use std::os::unix::ffi::OsStrExt;
+    use std::os::unix::io::AsRawFd;
+    let source = std::ffi::CString::new(format!("/proc/self/fd/{}", handle.as_raw_fd()))?;
+    let target = std::ffi::CString::new(target.as_os_str().as_bytes())?;
+    // SAFETY: both paths are NUL-terminated C strings that outlive the call.
+    let result = unsafe {
+        libc::linkat(
+            libc::AT_FDCWD,
+            source.as_ptr(),
+            libc::AT_FDCWD,
+            target.as_ptr(),
+            libc::AT_SYMLINK_FOLLOW,
+        )
+    };
+    if result == 0 {
+        Ok(())
+    } else {
+        Err(std::io::Error::last_os_error())
+    }
 }
 
 impl PendingWav {
@@ -324,30 +378,62 @@ impl PendingWav {
         let name = out.file_name().map_or("render.wav".into(), |name| {
             name.to_string_lossy().into_owned()
         });
-        let prefix = format!(".{name}.partial-");
-        let mut builder = tempfile::Builder::new();
-        builder.prefix(&prefix);
-        // A temporary file is private (0600) by default; the output gets the permissions any
-        // new file gets (0666 less the umask), as `File::create` would give it.
-        #[cfg(unix)]
-        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-        let file = builder
-            .tempfile_in(directory)
-            .map_err(|error| format!("cannot create a file in {}: {error}", directory.display()))?;
-        let (file, temporary) = file.into_parts();
         let spec = hound::WavSpec {
             channels: 1,
             sample_rate: sample_rate_hz.round() as u32,
             bits_per_sample: 32,
             sample_format: hound::SampleFormat::Float,
         };
+        let (file, temporary) = match Self::unnamed(directory) {
+            Some((file, temporary)) => (file, temporary),
+            None => {
+                let mut builder = tempfile::Builder::new();
+                let prefix = format!(".{name}.partial-");
+                builder.prefix(&prefix);
+                // A temporary file is private (0600) by default; the output gets the
+                // permissions any new file gets (0666 less the umask), as `File::create` would
+                // give it.
+                #[cfg(unix)]
+                builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+                let file = builder.tempfile_in(directory).map_err(|error| {
+                    format!("cannot create a file in {}: {error}", directory.display())
+                })?;
+                let (file, path) = file.into_parts();
+                (file, Temporary::Named(path))
+            }
+        };
         let writer = hound::WavWriter::new(BufWriter::new(file), spec)
-            .map_err(|error| format!("cannot write {}: {error}", temporary.display()))?;
+            .map_err(|error| format!("cannot write {}: {error}", out.display()))?;
         Ok(Self {
             writer,
             temporary,
             out: out.to_path_buf(),
+            name,
         })
+    }
+
+    #[cfg(target_os = "linux")]
+    fn unnamed(directory: &Path) -> Option<(std::fs::File, Temporary)> {
+        let file = unnamed_file(directory)?;
+        let handle = file.try_clone().ok()?;
+        Some((
+            file,
+            Temporary::Unnamed {
+                handle,
+                directory: directory.to_path_buf(),
+            },
+        ))
+    }
+
+    #[cfg(not(target_os = "linux"))]
+    fn unnamed(_directory: &Path) -> Option<(std::fs::File, Temporary)> {
+        None
+    }
+
+    /// True when the samples go to a file without a name.
+    #[cfg(test)]
+    fn is_unnamed(&self) -> bool {
+        !matches!(self.temporary, Temporary::Named(_))
     }
 
     fn write(&mut self, samples: &[f32]) -> Result<(), String> {
@@ -359,14 +445,26 @@ impl PendingWav {
         Ok(())
     }
 
-    /// Completes the WAV header and renames the file onto the output.
+    /// Completes the WAV header and puts the file in place of the output.
     fn commit(self) -> Result<(), String> {
         let fail =
             |error: &dyn std::fmt::Display| format!("cannot write {}: {error}", self.out.display());
         self.writer.finalize().map_err(|error| fail(&error))?;
-        self.temporary
-            .persist(&self.out)
-            .map_err(|error| fail(&error))
+        match self.temporary {
+            Temporary::Named(path) => path.persist(&self.out).map_err(|error| fail(&error)),
+            #[cfg(target_os = "linux")]
+            Temporary::Unnamed { handle, directory } => {
+                // A fresh hidden name beside the output, then an atomic rename onto it.
+                let named = tempfile::Builder::new()
+                    .prefix(&format!(".{}.partial-", self.name))
+                    .make_in(&directory, |path| name_unnamed_file(&handle, path))
+                    .map_err(|error| fail(&error))?;
+                named
+                    .into_temp_path()
+                    .persist(&self.out)
+                    .map_err(|error| fail(&error))
+            }
+        }
     }
 }
 
@@ -699,8 +797,8 @@ mod tests {
         wav.write(&[0.5; 1000]).unwrap();
         assert_eq!(
             file_names(&directory).len(),
-            2,
-            "the temporary file is beside the output"
+            if wav.is_unnamed() { 1 } else { 2 },
+            "the temporary file is beside the output, or has no name"
         );
         drop(wav);
         assert_eq!(std::fs::read(&out).unwrap(), b"the previous render");
@@ -717,6 +815,25 @@ mod tests {
         let permissions = |path: &Path| std::fs::metadata(path).unwrap().permissions();
         assert_eq!(permissions(&out), permissions(&created));
         std::fs::remove_file(&created).unwrap();
+        std::fs::remove_dir_all(&directory).unwrap();
+    }
+
+    #[test]
+    fn a_render_killed_outright_leaves_nothing_behind() {
+        let directory = scratch_directory("killed");
+        let out = directory.join("take.wav");
+        std::fs::write(&out, b"the previous render").unwrap();
+        let mut wav = PendingWav::create(&out, 44_100.0).unwrap();
+        wav.write(&[0.5; 10_000]).unwrap();
+        let unnamed = wav.is_unnamed();
+        // No destructor runs, as when the process is killed.
+        std::mem::forget(wav);
+        assert_eq!(std::fs::read(&out).unwrap(), b"the previous render");
+        if unnamed {
+            assert_eq!(file_names(&directory), ["take.wav"]);
+        } else {
+            println!("this file system makes no unnamed files: a hidden one stays behind");
+        }
         std::fs::remove_dir_all(&directory).unwrap();
     }
 
