@@ -126,6 +126,21 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
                 "Each pluck is up to this much softer than the full pluck.");
             row(ui, setter, &params.drone_seed,
                 "The humanisation's random sequence: the same seed always plays the same way.");
+            row(ui, setter, &params.tune_as_played,
+                "On: each string is tuned by the pitch it sounds 0.3 to 1.5 s after a pluck, as a player tunes by ear (measured on a background thread about a second after a string's first pluck). Off: by its small-amplitude pitch only, which a firm pluck or a crest contact can move by a few cents.");
+            egui::CollapsingHeader::new("Each drone string (in playing order)")
+                .default_open(false)
+                .show(ui, |ui| {
+                    for (index, string) in params.drone_strings.iter().enumerate() {
+                        ui.label(RichText::new(format!("String {}", index + 1)).strong());
+                        row(ui, setter, &string.fine_tune_cents,
+                            "Fine tuning of this string on top of its interval, cents.");
+                        row(ui, setter, &string.level_db,
+                            "Level of this string, dB: balance the strings as a player does.");
+                        row(ui, setter, &string.thread_offset_mm,
+                            "This string's thread, from the instrument's thread position: players set each string's jawari apart.");
+                    }
+                });
         });
         group(ui, "Jawari: thread and bridge", |ui| {
             row(ui, setter, &params.thread_enabled,
@@ -183,6 +198,8 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
                 "With output Pickup: 100 % is the force the string exerts on the nut (eq. 13, the seed's signal), 0 % the force on bridge and thread (eq. 12), in between a mix.");
             row(ui, setter, &params.output_gain_db,
                 "Output level. At 0 dB a pickup force of 2 N is digital full scale.");
+            row(ui, setter, &params.stereo_width_percent,
+                "How far the strings spread from left to right (drone strings in playing order, notes by pitch). The two channels always sum to the mono sound; 0 % is mono.");
         });
         ui.label(
             RichText::new("Double-click a slider to reset it; click its value to type one.")
