@@ -278,7 +278,7 @@ fn check_playable_notes(
     if settings.instrument != Instrument::Tanpura || settings.drone.enabled {
         return Ok(());
     }
-    let notes = played_notes(score);
+    let notes = score.played_notes();
     let unplayable: Vec<u8> = notes
         .iter()
         .copied()
@@ -655,20 +655,6 @@ fn write_spectrogram(
     Ok(())
 }
 
-/// The notes the score plays (note-ons with a velocity), in score order.
-fn played_notes(score: &Score) -> Vec<u8> {
-    score
-        .events
-        .iter()
-        .filter_map(|event| match event.action {
-            ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }) if velocity > 0.0 => {
-                Some(note)
-            }
-            _ => None,
-        })
-        .collect()
-}
-
 /// For a bowed preset: the stability margin of its Helmholtz motion (Woodhouse's analysis,
 /// `javari_core::stability::voice_link`) at every note the score plays, with the preset's bow
 /// controls; a warning for each note where it is unstable.
@@ -676,7 +662,7 @@ fn warn_if_bowed_preset_is_unstable(settings: &EngineSettings, score: &Score) {
     if settings.instrument != Instrument::Bowed {
         return;
     }
-    let mut notes = played_notes(score);
+    let mut notes = score.played_notes();
     notes.sort_unstable();
     notes.dedup();
     for note in notes {

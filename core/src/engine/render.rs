@@ -50,6 +50,19 @@ impl Score {
         score
     }
 
+    /// The notes the score plays (note-ons with a velocity), in score order.
+    pub fn played_notes(&self) -> Vec<u8> {
+        self.events
+            .iter()
+            .filter_map(|event| match event.action {
+                ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }) if velocity > 0.0 => {
+                    Some(note)
+                }
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Appends a note-on at `time_s` and its note-off `duration_s` later, keeping the order.
     pub fn note(&mut self, time_s: f64, duration_s: f64, note: u8, velocity: f32) {
         self.push(
@@ -173,17 +186,7 @@ pub fn calibration_requests(settings: &EngineSettings, score: &Score) -> Vec<Cal
     if !settings.tuning.as_played || settings.instrument != Instrument::Tanpura {
         return Vec::new();
     }
-    let notes: Vec<u8> = score
-        .events
-        .iter()
-        .filter_map(|event| match event.action {
-            ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }) if velocity > 0.0 => {
-                Some(note)
-            }
-            _ => None,
-        })
-        .collect();
-    Engine::planned_strings(settings, &notes)
+    Engine::planned_strings(settings, &score.played_notes())
 }
 
 /// [`render_blocks`] with the strings tuned as played by `calibrations` (see
