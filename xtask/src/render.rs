@@ -33,12 +33,11 @@ use javari_core::engine::bowed_stability::bowed_stability;
 use javari_core::engine::midi_file::{self, format_time, MidiScore};
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::preset::{Preset, QUALITY_NAMES};
-use javari_core::engine::render::ScoreAction;
 use javari_core::engine::render::{
     calibration_requests, render_blocks_calibrated, rendered_length, RenderOptions, Score,
 };
 use javari_core::engine::wav::read_wav;
-use javari_core::engine::{EngineEvent, EngineSettings, Instrument, VoiceRunner, VoiceTask};
+use javari_core::engine::{EngineSettings, Instrument, VoiceRunner, VoiceTask};
 use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
 use rayon::prelude::*;
