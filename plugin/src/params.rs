@@ -185,6 +185,34 @@ pub enum DronePatternChoice {
 }
 
 const MM_PER_M: f64 = 1000.0;
+
+const NOTE_NAMES: [&str; 12] = [
+    "C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B",
+];
+
+/// A MIDI note's name with its octave, middle C = C4 (48: "C3").
+fn note_name(note: i32) -> String {
+    format!(
+        "{}{}",
+        NOTE_NAMES[note.rem_euclid(12) as usize],
+        note.div_euclid(12) - 1
+    )
+}
+
+/// A note name ("G3", "F#2", "c4") or a MIDI number back to the note.
+fn parse_note_name(text: &str) -> Option<i32> {
+    let text = text.trim();
+    if let Ok(number) = text.parse::<i32>() {
+        return Some(number);
+    }
+    let split = text.find(|c: char| c == '-' || c.is_ascii_digit())?;
+    let (name, octave) = text.split_at(split);
+    let pitch = NOTE_NAMES
+        .iter()
+        .position(|candidate| candidate.eq_ignore_ascii_case(name))?;
+    let octave: i32 = octave.parse().ok()?;
+    Some((octave + 1) * 12 + pitch as i32)
+}
 const NS_PER_S: f64 = 1e9;
 
 fn millimetres(range_m: (f64, f64)) -> FloatRange {
@@ -304,6 +332,11 @@ pub struct JavariParams {
     pub drone_humanize_percent: FloatParam,
     #[id = "dseed"]
     pub drone_seed: IntParam,
+    /// Sa set here (the drone plays whenever drone mode is on) instead of by a held note.
+    #[id = "dsafix"]
+    pub drone_sa_fixed: BoolParam,
+    #[id = "dsa"]
+    pub drone_sa_note: IntParam,
     #[nested(array, group = "Drone string")]
     pub drone_strings: [DroneStringParams; MAX_DRONE_STRINGS],
     /// Tune each string by its sustained pitch as played (measured on a background thread).
@@ -506,6 +539,10 @@ impl Default for JavariParams {
             .with_unit(" %")
             .with_step_size(1.0),
             drone_seed: IntParam::new("Humanise seed", 0, IntRange::Linear { min: 0, max: 9999 }),
+            drone_sa_fixed: BoolParam::new("Drone Sa set here", false),
+            drone_sa_note: IntParam::new("Drone Sa", 48, IntRange::Linear { min: 24, max: 84 })
+                .with_value_to_string(Arc::new(|note| note_name(note)))
+                .with_string_to_value(Arc::new(|text| parse_note_name(&text))),
             drone_strings: Default::default(),
             tune_as_played: BoolParam::new("Tune as played", true),
             stereo_width_percent: FloatParam::new(
@@ -609,6 +646,10 @@ impl JavariParams {
             humanize_strength: f64::from(self.drone_humanize_percent.value()) / 100.0,
             humanize_seed: self.drone_seed.value().max(0) as u32,
             strings: std::array::from_fn(|index| self.drone_strings[index].settings()),
+            sa_note: self
+                .drone_sa_fixed
+                .value()
+                .then(|| self.drone_sa_note.value().clamp(0, 127) as u8),
         };
         let preset = match self.preset.value() {
             PresetChoice::Custom => None,
@@ -707,3 +748,28 @@ impl JavariParams {
 
 /// Number of factory presets (`presets/*.toml`, compiled into the plugin).
 pub const FACTORY_PRESET_COUNT: usize = 12;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn note_names_read_back() {
+        assert_eq!(note_name(48), "C3");
+        assert_eq!(note_name(55), "G3");
+        assert_eq!(note_name(61), "C#4");
+        for note in 0..128 {
+            assert_eq!(parse_note_name(&note_name(note)), Some(note));
+        }
+        assert_eq!(parse_note_name("g3"), Some(55));
+        assert_eq!(parse_note_name("50"), Some(50));
+        assert_eq!(parse_note_name("H2"), None);
+    }
+
+    #[test]
+    fn a_drone_sa_set_here_reaches_the_engine() {
+        let params = JavariParams::default();
+        let factory = crate::factory_presets();
+        assert_eq!(params.engine_settings(&factory).drone.sa_note, None);
+    }
+}

@@ -8,6 +8,10 @@
 //! - five strings: first, Ni (15/16), Sa, Sa, low Sa;
 //! - six strings: first, first, Sa, Sa, low Sa, low Sa.
 //!
+//! **Sa** is the held MIDI note (the drone plays while it is held), or a note set in the
+//! settings ([`DroneSettings::sa_note`]): then the drone plays whenever drone mode is on, as a
+//! tanpura box does, and MIDI notes do not touch it.
+//!
 //! **Timing.** A player plucks the strings evenly and lets the last one ring a little longer
 //! before starting again: a gap of [`DroneSettings::pluck_spacing_beats`] after each pluck and
 //! [`DroneSettings::cycle_pause_beats`] more after the last (the classic four-string cycle is
@@ -125,6 +129,9 @@ pub struct DroneSettings {
     /// Largest softening of a pluck, fraction of the full pluck (0–0.5).
     pub humanize_strength: f64,
     pub humanize_seed: u32,
+    /// Sa as a MIDI note (the drone plays whenever drone mode is on, no note held), or `None`:
+    /// the held note sets Sa and the drone plays while it is held.
+    pub sa_note: Option<u8>,
     /// Each string's fine tuning, level and thread, in playing order.
     pub strings: [DroneString; MAX_DRONE_STRINGS],
 }
@@ -142,6 +149,7 @@ impl Default for DroneSettings {
             humanize_timing_s: 0.0,
             humanize_strength: 0.0,
             humanize_seed: 0,
+            sa_note: None,
             strings: [DroneString::default(); MAX_DRONE_STRINGS],
         }
     }
@@ -234,13 +242,29 @@ impl DroneSequencer {
         self.press_counter += 1;
         self.held_order[usize::from(note & 0x7f)] = self.press_counter;
         if was_idle {
-            self.next_pluck_time = Some(now as f64);
-            self.next_string = 0;
-            self.pluck_index = 0;
-            self.anchor_time = now as f64;
-            self.anchor_tempo_bpm = 0.0;
-            self.beats_since_anchor = 0.0;
+            self.start(now);
         }
+    }
+
+    /// Starts the cycle at absolute sample `now` with the first string, without a held note
+    /// (Sa set by [`DroneSettings::sa_note`]).
+    pub fn start(&mut self, now: u64) {
+        self.next_pluck_time = Some(now as f64);
+        self.next_string = 0;
+        self.pluck_index = 0;
+        self.anchor_time = now as f64;
+        self.anchor_tempo_bpm = 0.0;
+        self.beats_since_anchor = 0.0;
+    }
+
+    /// Stops the cycle (the strings ring on).
+    pub fn stop(&mut self) {
+        self.next_pluck_time = None;
+    }
+
+    /// True while the cycle runs.
+    pub fn is_running(&self) -> bool {
+        self.next_pluck_time.is_some()
     }
 
     /// A note is released; when no note is held any more the cycle stops (the strings ring on).

@@ -296,6 +296,7 @@ impl EngineSettings {
                     default.drone.humanize_strength,
                 ),
                 strings: self.drone.strings.map(|string| string.clamped()),
+                sa_note: self.drone.sa_note.map(|note| note.min(127)),
                 ..self.drone
             },
             instrument: self.instrument,
@@ -807,6 +808,11 @@ impl Engine {
                 strings.push(request);
             }
         };
+        let fixed_sa = settings.drone.sa_note.filter(|_| settings.drone.enabled);
+        let notes: &[u8] = match &fixed_sa {
+            Some(sa) => std::slice::from_ref(sa),
+            None => notes,
+        };
         for &note in notes {
             let hz = settings.tuning.note_hz(note);
             if settings.drone.enabled {
@@ -1156,7 +1162,9 @@ impl Engine {
         match event {
             EngineEvent::NoteOn { note, velocity } if velocity > 0.0 => {
                 if self.target.drone.enabled {
-                    self.drone.note_on(note, self.clock);
+                    if self.target.drone.sa_note.is_none() {
+                        self.drone.note_on(note, self.clock);
+                    }
                 } else if let Some(hz) = self.target.tuning.playable_note_hz(note) {
                     self.pluck_string(StringKey::Note(note), hz, velocity);
                 }
@@ -1188,6 +1196,15 @@ impl Engine {
             return;
         }
         let drone = self.target.drone;
+        match drone.sa_note {
+            // A set Sa plays whenever drone mode is on.
+            Some(_) if !self.drone.is_running() => self.drone.start(self.clock),
+            // Back to the held note with none held: the cycle stops.
+            None if self.drone.sa_note().is_none() && self.drone.is_running() => {
+                self.drone.stop();
+            }
+            _ => {}
+        }
         let tempo = match (drone.tempo_sync, self.host_tempo_bpm) {
             (true, Some(host)) => host,
             _ => drone.free_tempo_bpm,
@@ -1198,7 +1215,7 @@ impl Engine {
         else {
             return;
         };
-        let Some(sa_note) = self.drone.sa_note() else {
+        let Some(sa_note) = drone.sa_note.or_else(|| self.drone.sa_note()) else {
             return;
         };
         let (ratios, _) = string_ratios(drone.first_string, drone.pattern);

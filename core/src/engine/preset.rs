@@ -36,6 +36,7 @@
 //! | `drone_humanize_timing_s` | s | 0–0.05 | largest timing displacement of a pluck |
 //! | `drone_humanize_strength` | 1 | 0–0.5 | largest softening of a pluck |
 //! | `drone_humanize_seed` | 1 | 0–4294967295 | the humanisation's seed (whole number) |
+//! | `drone_sa_note` | MIDI note | 0–127 | Sa set here: the drone plays whenever drone mode is on (left out: the held note sets Sa) |
 //! | `drone_string_fine_tune_cents` | cents | up to 6 of −50–50 | each drone string's fine tuning, in playing order (missing strings: 0) |
 //! | `drone_string_level_db` | dB | up to 6 of −60–6 | each drone string's level |
 //! | `drone_string_thread_offset_m` | m | up to 6 of −0.005–0.005 | each drone string's thread, from `thread_position_m` |
@@ -162,7 +163,7 @@ impl Kind {
 }
 
 /// Every key and what it takes, in the order of [`PresetFile`] and of the table above.
-const KEYS: [(&str, Kind); 40] = [
+const KEYS: [(&str, Kind); 41] = [
     ("name", Kind::Text),
     (
         "bridge_stiffness_n_m2",
@@ -207,6 +208,7 @@ const KEYS: [(&str, Kind); 40] = [
         Kind::Number(HUMANIZE_STRENGTH_RANGE),
     ),
     ("drone_humanize_seed", Kind::Number((0.0, 4_294_967_295.0))),
+    ("drone_sa_note", Kind::Number((0.0, 127.0))),
     (
         "drone_string_fine_tune_cents",
         Kind::Numbers(STRING_FINE_TUNE_RANGE_CENTS),
@@ -269,6 +271,7 @@ struct PresetFile {
     drone_humanize_timing_s: Option<Spanned<f64>>,
     drone_humanize_strength: Option<Spanned<f64>>,
     drone_humanize_seed: Option<Spanned<f64>>,
+    drone_sa_note: Option<Spanned<f64>>,
     drone_string_fine_tune_cents: Option<Spanned<Vec<f64>>>,
     drone_string_level_db: Option<Spanned<Vec<f64>>>,
     drone_string_thread_offset_m: Option<Spanned<Vec<f64>>>,
@@ -561,6 +564,9 @@ impl Preset {
             &mut settings.drone.humanize_strength,
             check.number("drone_humanize_strength", read.drone_humanize_strength)?,
         );
+        if let Some(note) = check.number("drone_sa_note", read.drone_sa_note)? {
+            settings.drone.sa_note = Some(note.round() as u8);
+        }
         let strings = &mut settings.drone.strings;
         for (index, value) in check
             .numbers(
@@ -697,6 +703,10 @@ impl Preset {
             drone_humanize_timing_s: value(s.drone.humanize_timing_s),
             drone_humanize_strength: value(s.drone.humanize_strength),
             drone_humanize_seed: value(f64::from(s.drone.humanize_seed)),
+            drone_sa_note: s
+                .drone
+                .sa_note
+                .map(|note| Spanned::new(0..0, f64::from(note))),
             drone_string_fine_tune_cents: list(
                 s.drone.strings.map(|string| string.fine_tune_cents),
             ),

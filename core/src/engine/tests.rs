@@ -566,3 +566,66 @@ fn a_glide_retunes_one_ringing_string_per_control_tick_and_every_string_reaches_
         assert!((thread - 0.042).abs() < 1e-12, "string {index}: {thread}");
     }
 }
+
+#[test]
+fn a_drone_sa_set_in_the_settings_plays_without_a_held_note_and_stops_when_unset() {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Draft;
+    settings.drone.enabled = true;
+    settings.drone.sa_note = Some(50);
+    let mut engine = Engine::new(&settings, RATE, 4);
+    engine.set_host_tempo(Some(120.0));
+    // No note: the first string (Pa) is plucked at once, tuned from D3.
+    run(&mut engine, &[], 64);
+    let first = engine
+        .slots
+        .iter()
+        .find(|slot| slot.key == Some(StringKey::Drone(0)))
+        .expect("the first string is plucked without a note");
+    assert_eq!(first.plucked_at, 0);
+    assert!((first.fundamental_hz / (0.75 * pitch::note_to_hz(50)) - 1.0).abs() < 1e-12);
+    // A MIDI note does not move it.
+    run(&mut engine, &[note_on(0, 57)], 22_050);
+    let sa = engine
+        .slots
+        .iter()
+        .find(|slot| slot.key == Some(StringKey::Drone(1)))
+        .expect("the second string");
+    assert!((sa.fundamental_hz / pitch::note_to_hz(50) - 1.0).abs() < 1e-12);
+    // Back to the held note, with none held: the cycle stops.
+    settings.drone.sa_note = None;
+    engine.set_settings(&settings);
+    run(
+        &mut engine,
+        &[crate::engine::TimedEvent {
+            offset: 0,
+            event: EngineEvent::NoteOff { note: 57 },
+        }],
+        64,
+    );
+    let plucks = |engine: &Engine| {
+        engine
+            .slots
+            .iter()
+            .filter(|slot| slot.key.is_some())
+            .count()
+    };
+    let before = plucks(&engine);
+    run(&mut engine, &[], 4 * 22_050);
+    assert_eq!(plucks(&engine), before, "no pluck after the cycle stopped");
+    assert_eq!(
+        Engine::planned_strings(
+            &EngineSettings {
+                drone: drone::DroneSettings {
+                    sa_note: Some(50),
+                    ..settings.drone
+                },
+                ..settings
+            },
+            &[62, 64]
+        )
+        .len(),
+        3,
+        "a set Sa plans the drone's strings on Sa whatever the notes (Pa, Sa, low Sa)"
+    );
+}

@@ -104,6 +104,10 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
             );
             row(ui, setter, &params.drone_enabled,
                 "Drone mode: a held MIDI note sets Sa, and four strings (first string, Sa, Sa, low Sa) are plucked in the classic cycle.");
+            row(ui, setter, &params.drone_sa_fixed,
+                "On: Sa is the note below and the drone plays whenever drone mode is on, as a tanpura box does (MIDI notes leave it alone). Off: the held MIDI note sets Sa.");
+            row(ui, setter, &params.drone_sa_note,
+                "Sa when it is set here (C3 for a typical male voice, G3 for a female one); fine-tune it below.");
             row(ui, setter, &params.drone_first_string,
                 "Tuning of the first drone string, in just intonation below Sa: Pa = 3/4 (the fifth), Ma = 2/3 (the fourth), Ni = 15/16 (major seventh), komal Ni = 8/9 (minor seventh), Dha = 5/6 (major sixth).");
             row(ui, setter, &params.drone_tempo_sync,
