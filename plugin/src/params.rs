@@ -541,8 +541,8 @@ impl Default for JavariParams {
             drone_seed: IntParam::new("Humanise seed", 0, IntRange::Linear { min: 0, max: 9999 }),
             drone_sa_fixed: BoolParam::new("Drone Sa set here", false),
             drone_sa_note: IntParam::new("Drone Sa", 48, IntRange::Linear { min: 24, max: 84 })
-                .with_value_to_string(Arc::new(|note| note_name(note)))
-                .with_string_to_value(Arc::new(|text| parse_note_name(&text))),
+                .with_value_to_string(Arc::new(note_name))
+                .with_string_to_value(Arc::new(|text| parse_note_name(text))),
             drone_strings: Default::default(),
             tune_as_played: BoolParam::new("Tune as played", true),
             stereo_width_percent: FloatParam::new(
