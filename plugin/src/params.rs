@@ -542,7 +542,7 @@ impl Default for JavariParams {
             drone_sa_fixed: BoolParam::new("Drone Sa set here", false),
             drone_sa_note: IntParam::new("Drone Sa", 48, IntRange::Linear { min: 24, max: 84 })
                 .with_value_to_string(Arc::new(note_name))
-                .with_string_to_value(Arc::new(|text| parse_note_name(text))),
+                .with_string_to_value(Arc::new(|text: &str| parse_note_name(text))),
             drone_strings: Default::default(),
             tune_as_played: BoolParam::new("Tune as played", true),
             stereo_width_percent: FloatParam::new(
