@@ -76,7 +76,11 @@ pub struct RenderArgs {
     /// `--preset`.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = key_value)]
     set: Vec<(String, String)>,
-    /// Also write a spectrogram of the result as a PNG.
+    /// Write the stereo image (two channels, as the plugin plays: the strings spread by the
+    /// preset's `stereo_width`; their mid is the mono output) instead of the mono output.
+    #[arg(long)]
+    stereo: bool,
+    /// Also write a spectrogram of the result as a PNG (of the mid signal when stereo).
     #[arg(long, value_name = "FILE.png")]
     plot: Option<PathBuf>,
     /// Threads that run the voices (1 to 256; default: every core). The output is bit-identical
@@ -105,10 +109,12 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         quality,
         tail_seconds: tail_s,
         set,
+        stereo,
         plot,
         jobs,
         max_seconds,
     } = args;
+    let channels = if stereo { 2 } else { 1 };
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
     let quality = Quality::from_name(&quality);
 
@@ -158,6 +164,7 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let options = RenderOptions {
         sample_rate_hz,
         block_size,
+        channels,
         tail_s,
         ..RenderOptions::default()
     };
@@ -167,7 +174,7 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     check_length(
         length_s,
         max_seconds,
-        sample_rate_hz,
+        (sample_rate_hz, channels),
         &source,
         read.as_ref(),
     )?;
@@ -182,7 +189,7 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let started = Instant::now();
     let calibrations = calibrate(jobs, &settings, &score, sample_rate_hz)?;
     let mut progress = Progress::new(total, sample_rate_hz);
-    let mut wav = PendingWav::create(&out, sample_rate_hz)?;
+    let mut wav = PendingWav::create(&out, sample_rate_hz, channels)?;
     let mut peak = 0.0f32;
     let mut written = 0usize;
     render_on(
@@ -193,7 +200,7 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         &options,
         &mut |block| {
             peak = block.iter().fold(peak, |peak, x| peak.max(x.abs()));
-            written += block.len();
+            written += block.len() / channels;
             progress.update(written);
             wav.write(block)
         },
@@ -210,8 +217,9 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     wav.commit()?;
     let elapsed_s = started.elapsed().as_secs_f64();
     eprintln!(
-        "wrote {}: {written} samples, peak {:.1} dBFS, {:.2} s compute, real-time factor {:.2}",
+        "wrote {}: {written} samples ({channels} channel{}), peak {:.1} dBFS, {:.2} s compute, real-time factor {:.2}",
         out.display(),
+        if channels == 1 { "" } else { "s" },
         20.0 * f64::from(peak).log10(),
         elapsed_s,
         (written as f64 / sample_rate_hz) / elapsed_s
@@ -241,7 +249,7 @@ fn key_value(text: &str) -> Result<(String, String), String> {
 fn check_length(
     length_s: f64,
     max_seconds: f64,
-    sample_rate_hz: f64,
+    (sample_rate_hz, channels): (f64, usize),
     source: &str,
     read: Option<&MidiScore>,
 ) -> Result<(), String> {
@@ -255,7 +263,7 @@ fn check_length(
             format_time(length_s)
         ));
     }
-    let bytes = length_s * sample_rate_hz * WAV_BYTES_PER_SAMPLE as f64;
+    let bytes = length_s * sample_rate_hz * (channels * WAV_BYTES_PER_SAMPLE as usize) as f64;
     if bytes > WAV_MAX_DATA_BYTES as f64 {
         return Err(format!(
             "{source} would render {} at {sample_rate_hz} Hz, {:.1} GB of samples, more than a \
@@ -367,7 +375,7 @@ fn name_unnamed_file(handle: &std::fs::File, target: &Path) -> std::io::Result<(
 }
 
 impl PendingWav {
-    fn create(out: &Path, sample_rate_hz: f64) -> Result<Self, String> {
+    fn create(out: &Path, sample_rate_hz: f64, channels: usize) -> Result<Self, String> {
         let directory = match out.parent() {
             Some(parent) if !parent.as_os_str().is_empty() => parent,
             _ => Path::new("."),
@@ -378,7 +386,7 @@ impl PendingWav {
             name.to_string_lossy().into_owned()
         });
         let spec = hound::WavSpec {
-            channels: 1,
+            channels: channels.clamp(1, 2) as u16,
             sample_rate: sample_rate_hz.round() as u32,
             bits_per_sample: 32,
             sample_format: hound::SampleFormat::Float,
@@ -778,7 +786,7 @@ mod tests {
         let directory = scratch_directory("abandoned");
         let out = directory.join("take.wav");
         std::fs::write(&out, b"the previous render").unwrap();
-        let mut wav = PendingWav::create(&out, 44_100.0).unwrap();
+        let mut wav = PendingWav::create(&out, 44_100.0, 1).unwrap();
         wav.write(&[0.5; 1000]).unwrap();
         assert_eq!(
             file_names(&directory).len(),
@@ -789,7 +797,7 @@ mod tests {
         assert_eq!(std::fs::read(&out).unwrap(), b"the previous render");
         assert_eq!(file_names(&directory), ["take.wav"]);
 
-        let mut wav = PendingWav::create(&out, 44_100.0).unwrap();
+        let mut wav = PendingWav::create(&out, 44_100.0, 1).unwrap();
         wav.write(&[0.25, -0.5]).unwrap();
         wav.commit().unwrap();
         assert_eq!(read_wav(&out).unwrap(), (vec![0.25, -0.5], 44_100.0));
@@ -808,7 +816,7 @@ mod tests {
         let directory = scratch_directory("killed");
         let out = directory.join("take.wav");
         std::fs::write(&out, b"the previous render").unwrap();
-        let mut wav = PendingWav::create(&out, 44_100.0).unwrap();
+        let mut wav = PendingWav::create(&out, 44_100.0, 1).unwrap();
         wav.write(&[0.5; 10_000]).unwrap();
         let unnamed = wav.is_unnamed();
         // No destructor runs, as when the process is killed.
@@ -829,7 +837,7 @@ mod tests {
         let whole = directory.join("whole.wav");
         javari_core::engine::wav::write_wav(&whole, &signal, 48_000.0).unwrap();
         let streamed = directory.join("streamed.wav");
-        let mut wav = PendingWav::create(&streamed, 48_000.0).unwrap();
+        let mut wav = PendingWav::create(&streamed, 48_000.0, 1).unwrap();
         for block in signal.chunks(512) {
             wav.write(block).unwrap();
         }
@@ -942,10 +950,10 @@ mod tests {
         let args = RenderArgs::try_parse_from(["render"]).unwrap();
         assert_eq!(args.max_seconds, 3600.0);
         assert!(RenderArgs::try_parse_from(["render", "--max-seconds", "0"]).is_err());
-        assert!(check_length(3600.0, 3600.0, 44_100.0, "x", None).is_ok());
-        let error = check_length(f64::NAN, 3600.0, 44_100.0, "x", None).unwrap_err();
+        assert!(check_length(3600.0, 3600.0, (44_100.0, 1), "x", None).is_ok());
+        let error = check_length(f64::NAN, 3600.0, (44_100.0, 1), "x", None).unwrap_err();
         assert!(error.contains("--max-seconds"), "{error}");
-        let error = check_length(80_000.0, 86_400.0, 192_000.0, "x", None).unwrap_err();
+        let error = check_length(80_000.0, 86_400.0, (192_000.0, 1), "x", None).unwrap_err();
         assert!(error.contains("more than a WAV file holds"), "{error}");
     }
 }

@@ -887,9 +887,31 @@ impl Engine {
     /// width of 0 gives two equal channels. `left` and `right` must have the same length.
     /// Allocation-free, never panics.
     pub fn process_stereo(&mut self, events: &[TimedEvent], left: &mut [f32], right: &mut [f32]) {
+        self.process_stereo_inner(events, left, right, None);
+    }
+
+    /// [`Engine::process_stereo`] with the voices run by `runner`, as [`Engine::process_with`]:
+    /// bit-identical to it, allocates (offline rendering).
+    pub fn process_stereo_with(
+        &mut self,
+        events: &[TimedEvent],
+        left: &mut [f32],
+        right: &mut [f32],
+        runner: VoiceRunner<'_>,
+    ) {
+        self.process_stereo_inner(events, left, right, Some(runner));
+    }
+
+    fn process_stereo_inner(
+        &mut self,
+        events: &[TimedEvent],
+        left: &mut [f32],
+        right: &mut [f32],
+        runner: Option<VoiceRunner<'_>>,
+    ) {
         let length = left.len().min(right.len());
         let (left, right) = (&mut left[..length], &mut right[..length]);
-        self.process_inner(events, left, Some(&mut *right), None);
+        self.process_inner(events, left, Some(&mut *right), runner);
         for (left, right) in left.iter_mut().zip(right.iter_mut()) {
             let (mid, side) = (*left, *right);
             *left = mid - side;

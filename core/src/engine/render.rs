@@ -92,6 +92,9 @@ pub struct RenderOptions {
     /// Time rendered after the score's last event, s.
     pub tail_s: f64,
     pub voice_count: usize,
+    /// 1: the mono output; 2: the stereo image ([`Engine::process_stereo`]), the blocks
+    /// handed out interleaved (left, right).
+    pub channels: usize,
 }
 
 impl Default for RenderOptions {
@@ -101,6 +104,7 @@ impl Default for RenderOptions {
             block_size: 512,
             tail_s: 3.0,
             voice_count: DEFAULT_VOICE_COUNT,
+            channels: 1,
         }
     }
 }
@@ -152,11 +156,12 @@ fn collect(
     progress: &mut dyn FnMut(usize, usize),
 ) -> Vec<f32> {
     let total = rendered_length(score, options);
-    let mut output = Vec::with_capacity(total);
+    let channels = options.channels.max(1);
+    let mut output = Vec::with_capacity(total * channels);
     let streamed: Result<(), std::convert::Infallible> =
         render_blocks(settings, score, options, runner, &mut |block| {
             output.extend_from_slice(block);
-            progress(output.len(), total);
+            progress(output.len() / channels, total);
             Ok(())
         });
     let Ok(()) = streamed;
@@ -206,6 +211,9 @@ pub fn render_blocks_calibrated<E>(
     let total = rendered_length(score, options);
     let block_size = options.block_size.max(1);
     let mut output = vec![0.0f32; block_size];
+    let stereo = options.channels == 2;
+    let mut right = vec![0.0f32; if stereo { block_size } else { 0 }];
+    let mut interleaved = vec![0.0f32; if stereo { 2 * block_size } else { 0 }];
     let mut block_events: Vec<TimedEvent> = Vec::with_capacity(MAX_EVENTS_PER_CALL);
     let mut next_event = 0;
     let mut start = 0;
@@ -243,11 +251,25 @@ pub fn render_blocks_calibrated<E>(
             next_event += 1;
         }
         let block = &mut output[..end - start];
-        match runner {
-            None => engine.process(&block_events, block),
-            Some(runner) => engine.process_with(&block_events, block, runner),
+        if stereo {
+            let right = &mut right[..end - start];
+            match runner {
+                None => engine.process_stereo(&block_events, block, right),
+                Some(runner) => engine.process_stereo_with(&block_events, block, right, runner),
+            }
+            let interleaved = &mut interleaved[..2 * (end - start)];
+            for ((pair, left), right) in interleaved.chunks_exact_mut(2).zip(&*block).zip(&*right) {
+                pair[0] = *left;
+                pair[1] = *right;
+            }
+            emit(interleaved)?;
+        } else {
+            match runner {
+                None => engine.process(&block_events, block),
+                Some(runner) => engine.process_with(&block_events, block, runner),
+            }
+            emit(block)?;
         }
-        emit(block)?;
         start = end;
     }
     Ok(())
@@ -274,6 +296,36 @@ mod tests {
             })
         );
         assert_eq!(score.end_s, 2.0);
+    }
+
+    #[test]
+    fn a_stereo_render_is_interleaved_and_its_mid_is_the_mono_render() {
+        let mut score = Score::default();
+        for (index, note) in [43u8, 55, 67].into_iter().enumerate() {
+            score.note(0.01 * index as f64, 0.1, note, 0.9);
+        }
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = crate::tanpura::quality::Quality::Draft;
+        settings.stereo_width = 1.0;
+        let mono_options = RenderOptions {
+            tail_s: 0.2,
+            block_size: 100,
+            ..RenderOptions::default()
+        };
+        let stereo_options = RenderOptions {
+            channels: 2,
+            ..mono_options
+        };
+        let mono = render(&settings, &score, &mono_options, &mut |_, _| {});
+        let stereo = render(&settings, &score, &stereo_options, &mut |_, _| {});
+        assert_eq!(stereo.len(), 2 * mono.len());
+        let mut differ = false;
+        for (pair, mono) in stereo.chunks_exact(2).zip(&mono) {
+            let (left, right) = (pair[0], pair[1]);
+            assert!((0.5 * (left + right) - mono).abs() <= 1e-6 * (left.abs() + right.abs()));
+            differ |= left != right;
+        }
+        assert!(differ, "notes by pitch spread over the image");
     }
 
     #[test]

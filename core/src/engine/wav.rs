@@ -25,14 +25,18 @@ pub fn write_wav(path: &Path, signal: &[f32], sample_rate_hz: f64) -> Result<(),
     writer.finalize().map_err(fail)
 }
 
-/// Reads a mono 32-bit float WAV file written by [`write_wav`]: the samples and the rate, Hz.
+/// Reads a mono 32-bit float WAV file written by [`write_wav`] (or a stereo one, as its mid
+/// signal `(left + right) / 2`, which is the mono output for Javari's stereo): the samples and
+/// the rate, Hz.
 pub fn read_wav(path: &Path) -> Result<(Vec<f32>, f64), String> {
     let fail = |error: hound::Error| format!("cannot read {}: {error}", path.display());
     let mut reader = hound::WavReader::open(path).map_err(fail)?;
     let spec = reader.spec();
-    if spec.channels != 1 || spec.sample_format != hound::SampleFormat::Float {
+    if !(spec.channels == 1 || spec.channels == 2)
+        || spec.sample_format != hound::SampleFormat::Float
+    {
         return Err(format!(
-            "{}: expected mono 32-bit float, found {} channels of {:?}",
+            "{}: expected mono or stereo 32-bit float, found {} channels of {:?}",
             path.display(),
             spec.channels,
             spec.sample_format
@@ -42,6 +46,14 @@ pub fn read_wav(path: &Path) -> Result<(Vec<f32>, f64), String> {
         .samples::<f32>()
         .collect::<Result<Vec<f32>, _>>()
         .map_err(fail)?;
+    let samples = if spec.channels == 2 {
+        samples
+            .chunks_exact(2)
+            .map(|pair| 0.5 * (pair[0] + pair[1]))
+            .collect()
+    } else {
+        samples
+    };
     Ok((samples, f64::from(spec.sample_rate)))
 }
 
