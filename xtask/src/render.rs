@@ -83,6 +83,10 @@ pub struct RenderArgs {
     /// Also write a spectrogram of the result as a PNG (of the mid signal when stereo).
     #[arg(long, value_name = "FILE.png")]
     plot: Option<PathBuf>,
+    /// Also write the result's long-term spectrum as a PNG (the radiated spectrum when the
+    /// output is radiated): power averaged over the whole render, dB re its peak, to 16 kHz.
+    #[arg(long, value_name = "FILE.png")]
+    spectrum: Option<PathBuf>,
     /// Threads that run the voices (1 to 256; default: every core). The output is bit-identical
     /// for any number.
     #[arg(long, value_name = "N", value_parser = number_in(1usize, 256))]
@@ -111,6 +115,7 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         set,
         stereo,
         plot,
+        spectrum,
         jobs,
         max_seconds,
     } = args;
@@ -224,10 +229,16 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         elapsed_s,
         (written as f64 / sample_rate_hz) / elapsed_s
     );
-    if let Some(plot) = plot {
+    if plot.is_some() || spectrum.is_some() {
         let (signal, _) = read_wav(&out)?;
-        write_spectrogram(&plot, &signal, sample_rate_hz)?;
-        eprintln!("wrote the spectrogram {}", plot.display());
+        if let Some(plot) = plot {
+            write_spectrogram(&plot, &signal, sample_rate_hz)?;
+            eprintln!("wrote the spectrogram {}", plot.display());
+        }
+        if let Some(path) = spectrum {
+            write_long_term_spectrum(&path, &signal, sample_rate_hz, &settings)?;
+            eprintln!("wrote the long-term spectrum {}", path.display());
+        }
     }
     Ok(())
 }
@@ -662,6 +673,71 @@ fn write_spectrogram(
     Ok(())
 }
 
+/// Frame of the long-term spectrum, samples (5.4 Hz bins at 44.1 kHz), hopped by half.
+const LONG_TERM_FRAME: usize = 8192;
+/// Highest frequency and lowest level the long-term spectrum shows.
+const LONG_TERM_TOP_HZ: f64 = 16_000.0;
+const LONG_TERM_RANGE_DB: f64 = 100.0;
+
+/// The power spectrum of `signal` averaged over Hann-windowed frames (Welch), in dB re its
+/// largest bin (floored at −100 dB), from the first bin up to 16 kHz (or Nyquist):
+/// (frequency in Hz, level in dB) per bin.
+fn long_term_spectrum(signal: &[f32], sample_rate_hz: f64) -> Vec<(f64, f64)> {
+    let samples: Vec<f64> = signal.iter().map(|&x| f64::from(x)).collect();
+    let hop = LONG_TERM_FRAME / 2;
+    let frames = (samples.len().saturating_sub(LONG_TERM_FRAME) / hop + 1).max(1);
+    let mut average = vec![0.0; LONG_TERM_FRAME / 2 + 1];
+    for frame in 0..frames {
+        let spectrum = power_spectrum(&samples, frame * hop, LONG_TERM_FRAME, LONG_TERM_FRAME);
+        for (sum, power) in average.iter_mut().zip(spectrum) {
+            *sum += power / frames as f64;
+        }
+    }
+    let bin_hz = sample_rate_hz / LONG_TERM_FRAME as f64;
+    let top_hz = LONG_TERM_TOP_HZ.min(0.5 * sample_rate_hz);
+    let loudest = average.iter().cloned().fold(0.0, f64::max).max(1e-30);
+    average
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(bin, power)| {
+            (
+                bin as f64 * bin_hz,
+                10.0 * (power / loudest + 1e-30).log10(),
+            )
+        })
+        .take_while(|(frequency, _)| *frequency <= top_hz)
+        .map(|(frequency, level)| (frequency, level.max(-LONG_TERM_RANGE_DB)))
+        .collect()
+}
+
+/// [`long_term_spectrum`] as a line plot at `path`.
+fn write_long_term_spectrum(
+    path: &std::path::Path,
+    signal: &[f32],
+    sample_rate_hz: f64,
+    settings: &EngineSettings,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let points = long_term_spectrum(signal, sample_rate_hz);
+    let what = match (settings.instrument, settings.tanpura_output) {
+        (Instrument::Bowed, _) => "bowed string",
+        (Instrument::Tanpura, javari_core::engine::TanpuraOutput::Radiated) => "radiated sound",
+        (Instrument::Tanpura, javari_core::engine::TanpuraOutput::Pickup) => "pickup force",
+    };
+    crate::plot::line_plot(
+        path,
+        &crate::plot::LinePlot {
+            title: format!("Long-term spectrum of the {what} (dB re its peak)"),
+            x_label: "frequency (Hz)".into(),
+            y_label: "level (dB)".into(),
+            y_scale: crate::plot::AxisScale::Linear,
+            right_label: None,
+            series: vec![crate::plot::Series::new(what, points, [40, 70, 160])],
+        },
+    )?;
+    Ok(())
+}
+
 /// For a bowed preset: the stability margin of its Helmholtz motion (Woodhouse's analysis,
 /// `javari_core::stability::voice_link`) at every note the score plays, with the preset's bow
 /// controls; a warning for each note where it is unstable.
@@ -809,6 +885,30 @@ mod tests {
         assert_eq!(permissions(&out), permissions(&created));
         std::fs::remove_file(&created).unwrap();
         std::fs::remove_dir_all(&directory).unwrap();
+    }
+
+    #[test]
+    fn the_long_term_spectrum_of_a_tone_peaks_at_its_frequency() {
+        let rate = 44_100.0;
+        let tone: Vec<f32> = (0..3 * 44_100)
+            .map(|n| (2.0 * std::f64::consts::PI * 1000.0 * n as f64 / rate).sin() as f32)
+            .collect();
+        let spectrum = long_term_spectrum(&tone, rate);
+        let (peak_hz, peak_db) = spectrum
+            .iter()
+            .cloned()
+            .fold(
+                (0.0, f64::MIN),
+                |best, point| if point.1 > best.1 { point } else { best },
+            );
+        assert!(
+            (peak_hz - 1000.0).abs() < rate / LONG_TERM_FRAME as f64,
+            "{peak_hz} Hz"
+        );
+        assert_eq!(peak_db, 0.0);
+        assert!(spectrum.last().unwrap().0 <= LONG_TERM_TOP_HZ);
+        let far = spectrum.iter().find(|point| point.0 > 4000.0).unwrap();
+        assert!(far.1 < -60.0, "{far:?}: a pure tone has nothing at 4 kHz");
     }
 
     #[test]
