@@ -22,12 +22,14 @@
 use arbitrary::{Arbitrary, Unstructured};
 use javari::params::JavariParams;
 use javari_core::bowed::BowTier;
+use javari_core::engine::drone::{DronePattern, MAX_DRONE_STRINGS};
 use javari_core::engine::midi_file;
 use javari_core::engine::preset::Preset;
 use javari_core::engine::render::{rendered_length, RenderOptions, ScoreAction};
 use javari_core::engine::{
     BowedStringKind, Engine, EngineEvent, EngineSettings, Instrument, TimedEvent,
 };
+use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::FirstString;
 use nice_assert_no_alloc::assert_no_alloc;
@@ -182,6 +184,14 @@ enum SettingChange {
     Glide(Number),
     Vibrato(Number),
     BodyEnabled(bool),
+    DronePattern(u8),
+    DroneSa(Option<u8>),
+    StringFineTune(u8, Number),
+    StringLevel(u8, Number),
+    StringThread(u8, Number),
+    TuneAsPlayed(bool),
+    TanpuraOutput(bool),
+    StereoWidth(Number),
 }
 
 impl SettingChange {
@@ -253,6 +263,31 @@ impl SettingChange {
                 bowed.player.max_vibrato_cents = value.scaled(0.0, 100.0)
             }
             SettingChange::BodyEnabled(on) => bowed.player.body_enabled = on,
+            SettingChange::DronePattern(index) => {
+                settings.drone.pattern = DronePattern::ALL[usize::from(index) % 3]
+            }
+            SettingChange::DroneSa(note) => settings.drone.sa_note = note,
+            SettingChange::StringFineTune(string, value) => {
+                settings.drone.strings[usize::from(string) % MAX_DRONE_STRINGS].fine_tune_cents =
+                    value.scaled(-50.0, 50.0)
+            }
+            SettingChange::StringLevel(string, value) => {
+                settings.drone.strings[usize::from(string) % MAX_DRONE_STRINGS].level_db =
+                    value.scaled(-60.0, 6.0)
+            }
+            SettingChange::StringThread(string, value) => {
+                settings.drone.strings[usize::from(string) % MAX_DRONE_STRINGS].thread_offset_m =
+                    value.scaled(-0.005, 0.005)
+            }
+            SettingChange::TuneAsPlayed(on) => settings.tuning.as_played = on,
+            SettingChange::TanpuraOutput(radiated) => {
+                settings.tanpura_output = if radiated {
+                    javari_core::engine::TanpuraOutput::Radiated
+                } else {
+                    javari_core::engine::TanpuraOutput::Pickup
+                }
+            }
+            SettingChange::StereoWidth(value) => settings.stereo_width = value.scaled(0.0, 1.0),
         }
     }
 }
@@ -304,7 +339,12 @@ enum Operation {
     Process {
         length: u16,
         events: Vec<(u16, FuzzEvent)>,
+        /// Through [`Engine::process_stereo`] (both channels checked).
+        stereo: bool,
     },
+    /// The host hands back a calibration of a wanted string with this offset (cents; a
+    /// hostile one too).
+    Calibrate(Number),
     Settings(Vec<SettingChange>),
     HostTempo(Option<Number>),
     Reset,
@@ -322,7 +362,8 @@ pub fn engine_events(bytes: &[u8]) {
         change.apply(&mut settings);
     }
     let mut engine = Engine::new(&settings, SAMPLE_RATE_HZ, VOICES);
-    let mut output = vec![0.0f32; MAX_SAMPLES_PER_INPUT];
+    // Left (or mono) and right halves.
+    let mut output = vec![0.0f32; 2 * MAX_SAMPLES_PER_INPUT];
     let mut events: Vec<TimedEvent> = Vec::with_capacity(256);
     let mut rendered = 0;
     for _ in 0..MAX_OPERATIONS {
@@ -333,6 +374,7 @@ pub fn engine_events(bytes: &[u8]) {
             Operation::Process {
                 length,
                 events: fuzz_events,
+                stereo,
             } => {
                 let length = usize::from(length).clamp(1, MAX_SAMPLES_PER_INPUT - rendered);
                 events.clear();
@@ -346,9 +388,15 @@ pub fn engine_events(bytes: &[u8]) {
                         }),
                 );
                 events.sort_by_key(|event| event.offset);
-                let block = &mut output[..length];
-                assert_no_alloc(|| engine.process(&events, block));
-                for (index, sample) in block.iter().enumerate() {
+                let (left, right) = output.split_at_mut(MAX_SAMPLES_PER_INPUT);
+                let (block, right) = (&mut left[..length], &mut right[..length]);
+                if stereo {
+                    assert_no_alloc(|| engine.process_stereo(&events, block, right));
+                } else {
+                    assert_no_alloc(|| engine.process(&events, block));
+                    right.fill(0.0);
+                }
+                for (index, sample) in block.iter().chain(right.iter()).enumerate() {
                     assert!(
                         sample.is_finite() && sample.abs() <= ENGINE_OUTPUT_BOUND,
                         "sample {} of the block is {sample}",
@@ -372,6 +420,16 @@ pub fn engine_events(bytes: &[u8]) {
             }
             Operation::Reset => {
                 assert_no_alloc(|| engine.reset());
+            }
+            Operation::Calibrate(offset) => {
+                if let Some(request) = assert_no_alloc(|| engine.take_wanted_calibration()) {
+                    let calibration = Calibration {
+                        request,
+                        sample_rate_hz: SAMPLE_RATE_HZ,
+                        offset_cents: offset.scaled(-50.0, 50.0),
+                    };
+                    assert_no_alloc(|| engine.set_calibration(&calibration));
+                }
             }
         }
     }

@@ -243,12 +243,17 @@ impl AsPlayedTuning {
             .any(|entry| entry.is_for(request, sample_rate_hz))
     }
 
-    /// Adds a calibration, replacing the one of the same note and tier, else a free entry, else
-    /// the oldest. Allocation-free.
-    pub fn insert(&mut self, calibration: Calibration) {
+    /// Adds a calibration (its offset clamped to ±[`MAX_OFFSET_CENTS`], a non-finite one
+    /// ignored), replacing the one of the same note and tier, else a free entry, else the
+    /// oldest. Allocation-free.
+    pub fn insert(&mut self, mut calibration: Calibration) {
         if !calibration.offset_cents.is_finite() {
             return;
         }
+        // What a calibration can find (a host handing back anything else is clamped).
+        calibration.offset_cents = calibration
+            .offset_cents
+            .clamp(-MAX_OFFSET_CENTS, MAX_OFFSET_CENTS);
         let slot = self
             .entries
             .iter()
