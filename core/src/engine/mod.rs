@@ -6,9 +6,14 @@
 //!   string does; a voice is taken from another string only by a new pluck: a string already
 //!   tuned to the note is plucked again, else a silent voice is used, else the quietest (then the
 //!   oldest) ringing one is stolen ([`Engine::choose_voice`]);
-//! - note to pitch: 12-TET, A4 = 440 Hz ([`pitch`]);
-//! - drone mode ([`drone`]): a held note sets Sa and the four strings are plucked in the classic
-//!   cycle at the host's tempo;
+//! - note to pitch: 12-TET from a reference A4 (415–466 Hz) with fine tuning ([`pitch`]);
+//! - drone mode ([`drone`]): a held note (or the settings' Sa) sets Sa and the strings (4, 5 or
+//!   6, each with its own fine tuning, level and thread) are plucked in the cycle at the host's
+//!   tempo;
+//! - each string tuned by its sustained pitch as played, from calibrations measured off the audio
+//!   thread (`tanpura/as_played.rs`, [`Engine::set_calibration`]);
+//! - stereo ([`Engine::process_stereo`]): the strings spread over the image by a side signal,
+//!   the mid exactly the mono output;
 //! - a change of quality tier applies to each string from its next pluck (a voice switching tier
 //!   restarts at rest, which would silence a ringing string);
 //! - smoothing of continuous settings in SI units ([`smoothing`]): the string settings move at
