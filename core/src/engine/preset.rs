@@ -789,6 +789,11 @@ mod tests {
         preset.settings.tuning.fine_tune_cents = -23.0;
         preset.settings.voice.quality = Quality::Studio;
         preset.settings.tanpura_output = TanpuraOutput::Radiated;
+        preset.settings.drone.sa_note = Some(55);
+        preset.settings.drone.strings[2].level_db = -4.5;
+        preset.settings.drone.strings[5].thread_offset_m = -0.002;
+        preset.settings.tuning.as_played = false;
+        preset.settings.stereo_width = 0.8;
         preset.settings.instrument = Instrument::Bowed;
         preset.settings.bowed.string = BowedStringKind::CelloD;
         preset.settings.bowed.player.tier = BowTier::BowTable;
@@ -862,9 +867,12 @@ mod tests {
 
     #[test]
     fn text_lists_every_key_in_order() {
+        let mut settings = EngineSettings::default();
+        // `drone_sa_note` is written only when Sa is set (left out, the held note sets it).
+        settings.drone.sa_note = Some(48);
         let text = Preset {
             name: "all".to_string(),
-            settings: EngineSettings::default(),
+            settings,
         }
         .to_text();
         let keys: Vec<&str> = text
