@@ -1,9 +1,9 @@
 //! The sustained pitch as played (0.3–1.5 s after the pluck) against each key's target, for one
 //! tier, with the linearised tuning alone and with the as-played calibration
 //! (`tanpura/as_played.rs`): `cargo run --release -p javari-core --example as_played -- TIER KEY…`
-//! (TIER: draft, live, studio or reference; keys default to 36–64). One row per key, one
-//! column per MIDI velocity, cents from the key's pitch; the last column is the largest
-//! deviation at velocities 40–110.
+//! (TIER: draft, live, studio or reference; keys default to 36–64; an argument such as `41mm`
+//! moves the thread from its 40 mm). One row per key, one column per MIDI velocity, cents from
+//! the key's pitch; the last column is the largest deviation at velocities 40–110.
 
 use javari_core::analysis::cents;
 use javari_core::engine::pitch::note_to_hz;
@@ -52,6 +52,10 @@ fn main() {
         .skip(1)
         .filter_map(|key| key.parse().ok())
         .collect();
+    let thread_position_m = arguments
+        .iter()
+        .find_map(|argument| argument.strip_suffix("mm")?.parse::<f64>().ok())
+        .map_or(VoiceSettings::default().thread_position_m, |mm| mm / 1000.0);
     if keys.is_empty() {
         keys = (36..=64).collect();
     }
@@ -64,6 +68,7 @@ fn main() {
                     let settings = VoiceSettings {
                         fundamental_hz: note_to_hz(key),
                         quality,
+                        thread_position_m,
                         ..VoiceSettings::default()
                     };
                     let offset = as_played_offset_cents(
@@ -85,8 +90,9 @@ fn main() {
     let mut rows = rows.into_inner().expect("a row thread panicked");
     rows.sort_by_key(|row| row.0);
     println!(
-        "{} tier, cents from the key's pitch at MIDI velocities {VELOCITIES:?}",
-        quality.name()
+        "{} tier, thread at {:.1} mm, cents from the key's pitch at MIDI velocities {VELOCITIES:?}",
+        quality.name(),
+        thread_position_m * 1000.0
     );
     println!("key  offset | linearised tuning                                | worst | as played                                        | worst");
     let (mut worst_linearised, mut worst_played): (f64, f64) = (0.0, 0.0);
