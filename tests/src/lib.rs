@@ -311,6 +311,16 @@ pub fn peak(signal: &[f32]) -> f32 {
     signal.iter().fold(0.0, |peak, x| peak.max(x.abs()))
 }
 
+/// What a host hears of the plugin's two channels, checked finite: the mid signal
+/// `(left + right) / 2`, which is the engine's mono output (`Engine::process_stereo`).
+pub fn finite_mid(left: &[f32], right: &[f32]) -> Vec<f32> {
+    assert!(
+        left.iter().chain(right).all(|x| x.is_finite()),
+        "non-finite sample"
+    );
+    left.iter().zip(right).map(|(l, r)| 0.5 * (l + r)).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

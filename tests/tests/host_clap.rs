@@ -16,7 +16,7 @@ use clack_host::prelude::*;
 use javari_core::engine::pitch::{cents, note_to_hz};
 use javari_core::engine::{Engine, EngineSettings};
 use javari_core::tanpura::quality::Quality;
-use javari_tests::{peak, peak_frequency_near, plugin_library};
+use javari_tests::{finite_mid, peak, peak_frequency_near, plugin_library};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -221,16 +221,8 @@ fn clap_plays_in_tune_at_several_rates_and_block_sizes() {
             note_at,
             0.6,
         );
-        assert!(
-            left.iter().chain(&right).all(|x| x.is_finite()),
-            "non-finite sample"
-        );
         // Stereo: the string panned by its pitch; the mid signal is the mono output.
-        let left: Vec<f32> = left
-            .iter()
-            .zip(&right)
-            .map(|(l, r)| 0.5 * (l + r))
-            .collect();
+        let left = finite_mid(&left, &right);
         assert!(peak(&left[..note_at]) == 0.0, "silent before the note");
         let ringing = &left[(0.1 * sample_rate) as usize..];
         let level = peak(ringing);

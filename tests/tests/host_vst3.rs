@@ -12,7 +12,7 @@
 use javari_core::engine::pitch::{cents, note_to_hz};
 use javari_core::engine::{Engine, EngineSettings};
 use javari_core::tanpura::quality::Quality;
-use javari_tests::{peak, peak_frequency_near, plugin_library};
+use javari_tests::{finite_mid, peak, peak_frequency_near, plugin_library};
 use std::cell::RefCell;
 use std::ffi::{c_void, CStr};
 use std::sync::atomic::{AtomicI32, Ordering};
@@ -369,16 +369,8 @@ fn vst3_plays_in_tune_at_several_rates_and_block_sizes() {
             note_at,
             0.6,
         );
-        assert!(
-            left.iter().chain(&right).all(|x| x.is_finite()),
-            "non-finite sample"
-        );
         // Stereo: the string panned by its pitch; the mid signal is the mono output.
-        let left: Vec<f32> = left
-            .iter()
-            .zip(&right)
-            .map(|(l, r)| 0.5 * (l + r))
-            .collect();
+        let left = finite_mid(&left, &right);
         assert_eq!(peak(&left[..note_at]), 0.0, "silent before the note");
         let ringing = &left[(0.1 * sample_rate) as usize..];
         let level = peak(ringing);

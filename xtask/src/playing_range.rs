@@ -16,8 +16,8 @@
 use javari_core::analysis::cents;
 use javari_core::analysis::listening::{compare, sustained_pitch_hz, ListeningDifference};
 use javari_core::analysis::playing_range::{
-    calibrate, full_grid, render_as_played, settings_for, GridPoint, KEYS, NOTE_SECONDS,
-    PLUCK_POSITIONS_M,
+    calibrate, calibration_request, full_grid, render_as_played, settings_for, GridPoint, KEYS,
+    NOTE_SECONDS, PLUCK_POSITIONS_M,
 };
 use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
@@ -131,22 +131,6 @@ fn calibration_cache_file(
     directory.join(format!("{:016x}.cents", hasher.finish()))
 }
 
-/// The calibration of a string with its offset not yet measured (what the cache fills in).
-fn calibrate_lazily(quality: Quality, key: u8, position: f64, sample_rate_hz: f64) -> Calibration {
-    let point = GridPoint {
-        key,
-        velocity: 127,
-        pluck_position_m: position,
-    };
-    let settings = settings_for(quality, &point);
-    let request = javari_core::engine::Engine::planned_strings(&settings, &[key])[0];
-    Calibration {
-        request,
-        sample_rate_hz,
-        offset_cents: 0.0,
-    }
-}
-
 fn read_cached_offset(path: &Path) -> Option<f64> {
     std::fs::read_to_string(path).ok()?.trim().parse().ok()
 }
@@ -224,10 +208,12 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
             let path = cache.as_ref().map(|(dir, version)| {
                 calibration_cache_file(dir, version, key, position, sample_rate_hz)
             });
-            let mut calibration = calibrate_lazily(quality, key, position, sample_rate_hz);
-            if let Some(offset) = path.as_deref().and_then(read_cached_offset) {
-                calibration.offset_cents = offset;
-                return calibration;
+            if let Some(offset_cents) = path.as_deref().and_then(read_cached_offset) {
+                return Calibration {
+                    request: calibration_request(quality, key, position),
+                    sample_rate_hz,
+                    offset_cents,
+                };
             }
             let measured = calibrate(quality, key, position, sample_rate_hz);
             if let Some(path) = path {

@@ -6,7 +6,7 @@
 //! sustained pitch as played ([`calibrate`], [`render_as_played`]).
 
 use crate::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
-use crate::tanpura::as_played::Calibration;
+use crate::tanpura::as_played::{Calibration, CalibrationRequest};
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::quality::Quality;
 use crate::tanpura::VoiceSettings;
@@ -89,17 +89,24 @@ pub fn calibrate(
     pluck_position_m: f64,
     sample_rate_hz: f64,
 ) -> Calibration {
+    Calibration::measure(
+        &calibration_request(quality, key, pluck_position_m),
+        sample_rate_hz,
+    )
+}
+
+/// What [`calibrate`] measures: the grid's string at `key` plucked at `pluck_position_m` on
+/// `quality`, as the engine plans it.
+pub fn calibration_request(quality: Quality, key: u8, pluck_position_m: f64) -> CalibrationRequest {
     let point = GridPoint {
         key,
         velocity: 127,
         pluck_position_m,
     };
-    let settings = settings_for(quality, &point);
-    let request = Engine::planned_strings(&settings, &[key])
+    Engine::planned_strings(&settings_for(quality, &point), &[key])
         .into_iter()
         .next()
-        .expect("every key of the grid is playable");
-    Calibration::measure(&request, sample_rate_hz)
+        .expect("every key of the grid is playable")
 }
 
 /// [`render`] with the string tuned as played by `calibration` (from [`calibrate`]).

@@ -101,7 +101,10 @@ impl OutputDelay {
         }
         let delayed = self.buffer[self.position];
         self.buffer[self.position] = value;
-        self.position = (self.position + 1) % self.length;
+        self.position += 1;
+        if self.position == self.length {
+            self.position = 0;
+        }
         delayed
     }
 }
@@ -435,7 +438,10 @@ struct Slot {
     fundamental_hz: f64,
     /// What its linearised tuning aims at: the note moved by its as-played offset.
     tuned_hz: f64,
-    /// Output scaling that keeps the level independent of pitch (see [`pitch_level_factor`]).
+    /// Output scaling that keeps the level independent of pitch (see [`pitch_level_factor`]),
+    /// fixed at the pluck.
+    pitch_level: f64,
+    /// `pitch_level` times a drone string's own level.
     level_factor: f64,
     /// Where the string sits in the stereo image, −1 (left) to 1 (right), before the width.
     pan: f32,
@@ -547,6 +553,11 @@ pub struct Engine {
     latency: usize,
     /// The slot [`Engine::control_tick`] looks at first for a string to retune.
     retune_cursor: usize,
+    /// Whether a ringing string may still lack the current settings (set when they change,
+    /// cleared by a control tick that finds none to retune).
+    retune_pending: bool,
+    /// Each drone string's level as an amplitude factor (from the settings, once per change).
+    drone_levels: [f64; drone::MAX_DRONE_STRINGS],
     /// Brings the bowed string (no latency of its own) up to it.
     bowed_delay: OutputDelay,
     /// The bow controls last applied from the settings (knobs), to apply only their changes.
@@ -593,6 +604,7 @@ impl Engine {
                 key: None,
                 fundamental_hz: voice.fundamental_hz,
                 tuned_hz: voice.fundamental_hz,
+                pitch_level: 1.0,
                 level_factor: 1.0,
                 pan: 0.0,
                 delay: OutputDelay::new(0),
@@ -644,6 +656,8 @@ impl Engine {
             applied_bow_controls: None,
             latency,
             retune_cursor: 0,
+            retune_pending: false,
+            drone_levels: settings.drone.strings.map(|string| string.level_factor()),
             bowed_delay: OutputDelay::new(latency),
             scratch: Vec::new(),
             body: Body::new(&TANPURA_BODY, sample_rate_hz),
@@ -744,7 +758,12 @@ impl Engine {
     /// there over [`SMOOTHING_TIME_S`]; switches and quality apply at the next control tick; the
     /// pluck applies from the next pluck. Allocation-free; out-of-range values are clamped.
     pub fn set_settings(&mut self, settings: &EngineSettings) {
+        let previous_strings = self.target.drone.strings;
         self.target = settings.clamped();
+        if self.target.drone.strings != previous_strings {
+            // A drone string's thread may have moved.
+            self.retune_pending = true;
+        }
         let voice = self.target.voice;
         self.bridge_stiffness_log
             .set_target(stiffness_to_log(voice.bridge_stiffness_n_m2));
@@ -754,6 +773,11 @@ impl Engine {
         self.pickup_weight.set_target(voice.nut_pickup_weight);
         self.output_gain
             .set_target(db_to_amplitude(self.target.output_gain_db));
+        self.drone_levels = self
+            .target
+            .drone
+            .strings
+            .map(|string| string.level_factor());
         self.apply_bowed_settings();
     }
 
@@ -1114,11 +1138,16 @@ impl Engine {
         for slot in &mut self.slots {
             if let Some(StringKey::Drone(index)) = slot.key {
                 // A drone string's level follows its setting while it rings.
-                slot.level_factor =
-                    pitch_level_factor(slot.fundamental_hz) * drone_strings[index].level_factor();
+                slot.level_factor = slot.pitch_level * self.drone_levels[index];
             }
         }
+        if settings != self.current_voice {
+            self.retune_pending = true;
+        }
         self.current_voice = settings;
+        if !self.retune_pending {
+            return;
+        }
         // At most one ringing string takes the new settings per control tick, the next in turn
         // whose settings differ: retuning a string (a new rest state and its linearised
         // fundamental) costs about a fifth of a 64-sample block's deadline at the live tier
@@ -1149,8 +1178,10 @@ impl Engine {
             }
             slot.voice.set_settings(&string_settings);
             self.retune_cursor = (index + 1) % count;
-            break;
+            return;
         }
+        // Every ringing string has the settings: nothing to look at until they change.
+        self.retune_pending = false;
     }
 
     /// The bowed instrument's reading of an event (`bowed/instrument.rs` documents the mapping).
@@ -1328,7 +1359,7 @@ impl Engine {
             string_settings.fundamental_hz *= (offset / 1200.0).exp2();
         }
         let level = match key {
-            StringKey::Drone(string) => self.target.drone.strings[string].level_factor(),
+            StringKey::Drone(string) => self.drone_levels[string],
             StringKey::Note(_) => 1.0,
         };
         let pan = match key {
@@ -1348,10 +1379,11 @@ impl Engine {
             slot.delay.clear();
             slot.key = Some(key);
             slot.fundamental_hz = fundamental_hz;
+            slot.pitch_level = pitch_level_factor(fundamental_hz);
         }
         slot.tuned_hz = string_settings.fundamental_hz;
         slot.pan = pan;
-        slot.level_factor = pitch_level_factor(fundamental_hz) * level;
+        slot.level_factor = slot.pitch_level * level;
         // Also brings a re-plucked string to the current quality tier.
         slot.voice.set_settings(&string_settings);
         let own_latency = slot.voice.latency_samples().round() as usize;
