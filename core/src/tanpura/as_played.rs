@@ -23,6 +23,12 @@
 //! the pitch scales with the target (`f ∝ √T` with the contact state unchanged); the second
 //! pass catches the contact state that the retuning itself moves.
 //!
+//! Where the string at rest just touches the crest the two ends can sound 10 cents apart (a soft
+//! pluck stays on the crest, a firm one lifts it off), and centring them is all a tension can do.
+//! Moving the thread 1 mm settles those notes, but they sit at the jawari's sweet spot and the
+//! move takes 7–13 dB off their level above 2 kHz (`examples/jawari_moves.rs`, README), so the
+//! calibration leaves the thread where the player put it.
+//!
 //! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the
 //! string's tier, so a calibration is an offline job (the renderer before it renders, a
 //! background thread in the plugin), never the audio thread's. The result is a plain number of
