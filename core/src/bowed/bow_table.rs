@@ -26,6 +26,19 @@
 //! Mapping of the physical bow force to STK's normalised pressure:
 //! pressure = clamp(F_b / `full_pressure_force_n`, 0, 1). F_b = 0 lifts the bow: the table is
 //! bypassed and the string rings down.
+//!
+//! **Blocks in runs** (`BowedVoice::process`). A wave pushed into a delay line comes back no
+//! sooner than the line's whole samples later, so the samples of a run no longer than the
+//! shorter line's whole delay (and at most `RUN` = 16 samples) read only waves pushed before the run: they
+//! are independent of each other except through the body filter. A run is rendered stage by
+//! stage: both lines' reads, the loss filter and the junctions (a branch-free loop over the
+//! run's samples that the compiler vectorises: the table's plateau test became a comparison
+//! that gives the same value bit for bit), the pushes, then the body filter and the output. The
+//! arithmetic of every sample is that of [`BowedVoice::next_sample`], so `process` reproduces it
+//! bit for bit (tests/bowed_reference.rs, down to delays shorter than a run); delays under four
+//! samples take the sample-by-sample path. Hand-written rather than on a SIMD crate: SSE2 pairs
+//! on generic x86-64 are what the compiler emits for these loops, and fused multiply-adds from a
+//! wider dispatch would change the round-off against `next_sample`.
 
 use super::body::{BodyFilter, BodyResonance, BodyRun, VIOLIN_BODY};
 use super::bowed_string::{all_finite, StringConstants, BOW_POSITION_RANGE};
@@ -53,6 +66,22 @@ pub fn bow_table_reflection(differential_velocity: f64, slope: f64) -> f64 {
     }
     let squared = base * base;
     (1.0 / (squared * squared)).min(1.0)
+}
+
+/// [`bow_table_reflection`] without the plateau's branch, bit for bit the same value: on the
+/// plateau base⁴ ≤ 1, so the quotient is ≥ 1 and the minimum is exactly 1 (base ≥ 0.75 keeps
+/// it finite). For runs of samples, where a branch per sample stops the loop from vectorising.
+#[inline(always)]
+fn bow_table_reflection_branch_free(differential_velocity: f64, slope: f64) -> f64 {
+    let base = differential_velocity.abs() * slope + 0.75;
+    let squared = base * base;
+    let quotient = 1.0 / (squared * squared);
+    // `quotient.min(1.0)` as a comparison (a NaN quotient gives 1 both ways), which vectorises.
+    if quotient < 1.0 {
+        quotient
+    } else {
+        1.0
+    }
 }
 
 /// Default force for full STK pressure, N: a firm violin bow stroke.
@@ -88,6 +117,7 @@ pub struct BowTableString {
     bow_velocity_m_s: f64,
     bow_position: f64,
     slope: f64,
+    run_scratch: RunScratch,
 }
 
 impl BowTableString {
@@ -119,6 +149,7 @@ impl BowTableString {
             bow_velocity_m_s: 0.0,
             bow_position: 0.1,
             slope: bow_table_slope(0.0),
+            run_scratch: RunScratch::default(),
         };
         voice.update_delays();
         voice
@@ -231,7 +262,8 @@ impl BowedVoice for BowTableString {
 
     /// The per-sample path works on the voice's fields directly: building a block's run state
     /// for one sample would cost more than the sample. [`Self::process`] runs the same
-    /// arithmetic (`TableRun::step`) bit for bit (tests/bowed_reference.rs).
+    /// arithmetic (`TableRun::step`, and by stages `TableRun::render_run`) bit for bit
+    /// (tests/bowed_reference.rs).
     #[inline]
     fn next_sample(&mut self) -> BowedOutput {
         let arriving_at_bridge = self.bridge.read(&self.bridge_delay);
@@ -303,6 +335,7 @@ impl BowTableString {
             bow_velocity_m_s: self.bow_velocity_m_s,
             slope: self.slope,
             wave_impedance_n_s_m: self.wave_impedance_n_s_m,
+            scratch: &mut self.run_scratch,
         };
         let result = work(&mut run);
         let filter_history = run.filter_history;
@@ -328,11 +361,175 @@ struct TableRun<'a, const G: usize> {
     bow_velocity_m_s: f64,
     slope: f64,
     wave_impedance_n_s_m: f64,
+    scratch: &'a mut RunScratch,
+}
+
+/// Reads `into.len()` consecutive samples of `line` at `delay`, as that many [`DelayCursor::read`]
+/// calls between pushes would; false (nothing read) when the delay is shorter than the run.
+#[inline(always)]
+fn read_run(line: &DelayCursor<'_>, delay: &FractionalDelay, into: &mut [f64]) -> bool {
+    let count = into.len();
+    if delay.whole() < count {
+        return false;
+    }
+    let window = line.window(delay.whole() + 1 - count, count + 1);
+    if window.len() != count + 1 {
+        return false;
+    }
+    let fraction = delay.fraction();
+    for (value, pair) in into.iter_mut().zip(window.windows(2)) {
+        let (older, newer) = (pair[0], pair[1]);
+        *value = newer + fraction * (older - newer);
+    }
+    true
+}
+
+/// Samples a run renders stage by stage ([`TableRun::render_run`]).
+const RUN: usize = 16;
+
+/// The per-sample values of a run ([`TableRun::render_run`]), kept in the voice so that no run
+/// clears or moves them: only the first samples of a run are written, and only those are read.
+#[derive(Clone, Debug)]
+struct RunScratch {
+    /// `arriving[k + 2]` is sample k's wave at the bridge; [0] and [1] the loss filter's history.
+    arriving: [f64; RUN + 2],
+    from_nut: [f64; RUN],
+    /// What the junctions send on: the waves pushed towards nut and bridge, the bridge force and
+    /// the string's velocity under the bow.
+    to_nut: [f64; RUN],
+    to_bridge: [f64; RUN],
+    bridge_force: [f64; RUN],
+    bow_point_velocity: [f64; RUN],
+}
+
+impl Default for RunScratch {
+    fn default() -> Self {
+        Self {
+            arriving: [0.0; RUN + 2],
+            from_nut: [0.0; RUN],
+            to_nut: [0.0; RUN],
+            to_bridge: [0.0; RUN],
+            bridge_force: [0.0; RUN],
+            bow_point_velocity: [0.0; RUN],
+        }
+    }
 }
 
 impl<const G: usize> TableRun<'_, G> {
     #[inline]
     fn render(&mut self, radiated: &mut [f32]) {
+        // A value pushed into a delay line is read back `whole` samples later at the earliest,
+        // so in a run of at most that many samples every read sees only values pushed before
+        // the run: the run's samples are independent but for the body filter.
+        let reach = self
+            .neck_delay
+            .whole()
+            .min(self.bridge_delay.whole())
+            .min(RUN);
+        if reach < 4 {
+            for sample in radiated.iter_mut() {
+                *sample = self.step().radiated as f32;
+            }
+            return;
+        }
+        for run in radiated.chunks_mut(reach) {
+            self.render_run(run);
+        }
+    }
+
+    /// [`Self::step`] for each sample of `radiated` (at most [`RUN`], and at most the shorter
+    /// delay's whole samples), the same arithmetic in the same order, but stage by stage over
+    /// the run: every read, then every junction, then every push, then the body. The stages
+    /// are loops over independent samples that the processor overlaps (and the compiler
+    /// vectorises), where the sample-by-sample loop is one long dependency chain per sample.
+    #[inline(always)]
+    fn render_run(&mut self, radiated: &mut [f32]) {
+        let count = radiated.len().min(RUN);
+        let scratch = &mut *self.scratch;
+        let read = read_run(
+            &self.bridge,
+            &self.bridge_delay,
+            &mut scratch.arriving[2..2 + count],
+        ) && read_run(&self.neck, &self.neck_delay, &mut scratch.from_nut[..count]);
+        if !read {
+            return self.render_by_sample(radiated);
+        }
+        let [previous, before_previous] = self.filter_history;
+        scratch.arriving[0] = before_previous;
+        scratch.arriving[1] = previous;
+        self.filter_history = [scratch.arriving[count + 1], scratch.arriving[count]];
+        if self.bow_on {
+            self.junctions::<true>(count);
+        } else {
+            self.junctions::<false>(count);
+        }
+        let scratch = &*self.scratch;
+        self.neck.push_run(&scratch.to_nut[..count]);
+        self.bridge.push_run(&scratch.to_bridge[..count]);
+
+        let mut probe = 0.0;
+        for ((sample, &force), &velocity) in radiated[..count]
+            .iter_mut()
+            .zip(&scratch.bridge_force[..count])
+            .zip(&scratch.bow_point_velocity[..count])
+        {
+            let out = if self.body_enabled {
+                self.body.tick(force)
+            } else {
+                force
+            };
+            probe += force * 0.0 + velocity * 0.0 + out * 0.0;
+            *sample = out as f32;
+        }
+        if probe != 0.0 {
+            // Some sample was not finite: silence from there on and reset, as `step` does at
+            // that sample (the rest of this run is silent; the next starts from rest).
+            let first = (0..count)
+                .find(|&k| {
+                    !all_finite([
+                        scratch.bridge_force[k],
+                        scratch.bow_point_velocity[k],
+                        f64::from(radiated[k]),
+                    ])
+                })
+                .unwrap_or(0);
+            radiated[first..].fill(0.0);
+            self.neck.reset();
+            self.bridge.reset();
+            self.filter_history = [0.0; 2];
+            self.body.reset();
+        }
+    }
+
+    /// The bow junction of each sample of a run (the middle of [`Self::step`]), branch-free so
+    /// that the loop vectorises.
+    #[inline(always)]
+    fn junctions<const BOW_ON: bool>(&mut self, count: usize) {
+        let scratch = &mut *self.scratch;
+        let arriving = &scratch.arriving;
+        for k in 0..count.min(RUN) {
+            let filtered = STRING_FILTER_GAIN
+                * (STRING_FILTER_SIDE_TAP * (arriving[k + 2] + arriving[k])
+                    + (1.0 - 2.0 * STRING_FILTER_SIDE_TAP) * arriving[k + 1]);
+            let bridge_reflection = -filtered;
+            let nut_reflection = -scratch.from_nut[k];
+            let string_velocity = bridge_reflection + nut_reflection;
+            let differential_velocity = self.bow_velocity_m_s - string_velocity;
+            let bow_wave = if BOW_ON {
+                differential_velocity
+                    * bow_table_reflection_branch_free(differential_velocity, self.slope)
+            } else {
+                0.0
+            };
+            scratch.to_nut[k] = bridge_reflection + bow_wave;
+            scratch.to_bridge[k] = nut_reflection + bow_wave;
+            scratch.bridge_force[k] =
+                self.wave_impedance_n_s_m * (arriving[k + 2] - bridge_reflection);
+            scratch.bow_point_velocity[k] = string_velocity + bow_wave;
+        }
+    }
+
+    fn render_by_sample(&mut self, radiated: &mut [f32]) {
         for sample in radiated.iter_mut() {
             *sample = self.step().radiated as f32;
         }

@@ -41,6 +41,19 @@ impl FractionalDelay {
     pub fn samples(&self) -> f64 {
         self.samples
     }
+
+    /// The whole samples of the delay: a read at this delay sees no value pushed in the last
+    /// `whole() − 1` samples.
+    #[inline]
+    pub fn whole(&self) -> usize {
+        self.whole
+    }
+
+    /// The fraction of a sample beyond [`Self::whole`], interpolated linearly.
+    #[inline]
+    pub fn fraction(&self) -> f64 {
+        self.fraction
+    }
 }
 
 /// A power-of-two ring of past values, mirrored so that windows never wrap.
@@ -134,6 +147,32 @@ impl DelayCursor<'_> {
     }
 
     /// As [`DelayHistory::window`].
+    /// Pushes `values` in order, as that many [`Self::push`] calls would.
+    #[inline]
+    pub fn push_run(&mut self, values: &[f64]) {
+        let mut rest = values;
+        while !rest.is_empty() {
+            // Up to the end of the ring, then from its start.
+            let length = rest.len().min(self.size - self.write);
+            let (now, later) = rest.split_at(length);
+            let low = self.write..self.write + length;
+            let high = self.write + self.size..self.write + self.size + length;
+            // Element by element: runs are a few samples, shorter than a `memmove` call.
+            if let Some(slice) = self.buffer.get_mut(low) {
+                for (stored, &value) in slice.iter_mut().zip(now) {
+                    *stored = value;
+                }
+            }
+            if let Some(slice) = self.buffer.get_mut(high) {
+                for (stored, &value) in slice.iter_mut().zip(now) {
+                    *stored = value;
+                }
+            }
+            self.write = (self.write + length) & (self.size - 1);
+            rest = later;
+        }
+    }
+
     #[inline]
     pub fn window(&self, newest_delay: usize, count: usize) -> &[f64] {
         window(self.buffer, self.size, self.write, newest_delay, count)
