@@ -323,9 +323,9 @@ fn process_reproduces_next_sample_bit_for_bit() {
     }
 }
 
-/// Bow positions and pitches whose bridge-side delay is shorter than the bow table's run of
-/// samples (`bow_table.rs`, `RUN`): runs of 4 to 7 samples, and below 4 the sample-by-sample
-/// path.
+/// Bow positions and pitches whose bridge-side delay is shorter than a run of `process`
+/// (16 samples, `bow_table.rs` and `bowed_string.rs`): runs of 4 to 7 samples, and below 4 the
+/// sample-by-sample path.
 const SHORT_DELAY_SCENES: [Scene; 3] = [
     // 49 samples around the loop, 4.9 of them bow → bridge: runs of 4.
     Scene {
@@ -354,16 +354,20 @@ const SHORT_DELAY_SCENES: [Scene; 3] = [
 ];
 
 #[test]
-fn bow_table_runs_reproduce_next_sample_at_short_delays() {
-    for scene in &SHORT_DELAY_SCENES {
-        let capacity = BowedCapacity::default();
-        let constants = StringConstants::violin_a();
-        let per_sample = render(&mut BowTableString::new(capacity, constants), scene);
+fn runs_reproduce_next_sample_at_short_delays() {
+    fn check<V: BowedVoice>(make: impl Fn() -> V, scene: &Scene, what: &str) {
+        let per_sample = render(&mut make(), scene);
         let peak = per_sample.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        assert!(peak > 1e-3, "{scene:?} must sound (peak {peak})");
-        let blocks = render_blocks(&mut BowTableString::new(capacity, constants), scene);
+        assert!(peak > 1e-3, "{what} {scene:?} must sound (peak {peak})");
+        let blocks = render_blocks(&mut make(), scene);
         for (n, (a, b)) in per_sample.iter().zip(&blocks).enumerate() {
-            assert_eq!((*a as f32).to_bits(), b.to_bits(), "table {scene:?} {n}");
+            assert_eq!((*a as f32).to_bits(), b.to_bits(), "{what} {scene:?} {n}");
         }
+    }
+    let capacity = BowedCapacity::default();
+    let constants = StringConstants::violin_a();
+    for scene in &SHORT_DELAY_SCENES {
+        check(|| BowTableString::new(capacity, constants), scene, "table");
+        check(|| BowedString::new(capacity, constants), scene, "rounded");
     }
 }

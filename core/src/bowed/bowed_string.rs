@@ -154,6 +154,8 @@ pub struct BowedString<F: FrictionLaw = HyperbolicFriction> {
     bow_velocity_m_s: f64,
     bow_position: f64,
     last_solution: BowPointSolution,
+    /// The per-sample values of a run of `process` ([`RoundedRun::render_run`]).
+    run_scratch: RunScratch,
 }
 
 impl BowedString<HyperbolicFriction> {
@@ -193,6 +195,7 @@ impl<F: FrictionLaw> BowedString<F> {
             bow_velocity_m_s: 0.0,
             bow_position: 0.1,
             last_solution: RESTING_SOLUTION,
+            run_scratch: RunScratch::default(),
         };
         voice.update_reflections();
         voice
@@ -458,6 +461,7 @@ impl<F: FrictionLaw> BowedString<F> {
             bow_force_n: self.bow_force_n,
             bow_velocity_m_s: self.bow_velocity_m_s,
             last_solution: self.last_solution,
+            scratch: &mut self.run_scratch,
         };
         let result = work(&mut run);
         let (bow, last_solution) = (run.bow, run.last_solution);
@@ -485,14 +489,142 @@ struct RoundedRun<'a, F, const G: usize> {
     bow_force_n: f64,
     bow_velocity_m_s: f64,
     last_solution: BowPointSolution,
+    scratch: &'a mut RunScratch,
+}
+
+/// Samples a run renders stage by stage ([`RoundedRun::render_run`]).
+const RUN: usize = 16;
+
+/// The per-sample values of a run, kept in the voice so that no run clears or moves them: only
+/// the first samples of a run are written, and only those are read.
+#[derive(Clone, Debug)]
+struct RunScratch {
+    incoming_bridge: [f64; RUN],
+    incoming_nut: [f64; RUN],
+    arriving_at_bridge: [f64; RUN],
+    /// The nut's round-trip read, which the voice does not use.
+    unused: [f64; RUN],
+    outgoing_bridge: [f64; RUN],
+    outgoing_nut: [f64; RUN],
+    velocity: [f64; RUN],
+}
+
+impl Default for RunScratch {
+    fn default() -> Self {
+        Self {
+            incoming_bridge: [0.0; RUN],
+            incoming_nut: [0.0; RUN],
+            arriving_at_bridge: [0.0; RUN],
+            unused: [0.0; RUN],
+            outgoing_bridge: [0.0; RUN],
+            outgoing_nut: [0.0; RUN],
+            velocity: [0.0; RUN],
+        }
+    }
 }
 
 impl<F: FrictionLaw, const G: usize> RoundedRun<'_, F, G> {
     #[inline]
     fn render(&mut self, radiated: &mut [f32]) {
+        // A wave pushed into either line comes back no sooner than its first tap's delay (or
+        // the round trip), so in a run no longer than that every read sees only waves pushed
+        // before the run: the reads of the run's samples are independent.
+        let reach = self.bridge.run_reach().min(self.nut.run_reach()).min(RUN);
+        if reach < 4 {
+            self.render_by_sample(radiated);
+            return;
+        }
+        for run in radiated.chunks_mut(reach) {
+            self.render_run(run);
+        }
+    }
+
+    fn render_by_sample(&mut self, radiated: &mut [f32]) {
         for sample in radiated.iter_mut() {
             *sample = self.step().radiated as f32;
         }
+    }
+
+    /// [`Self::step`] for each sample of `radiated` (at most [`RUN`] and the lines' reach), the
+    /// same arithmetic in the same order, by stages: every read and convolution, then the bow
+    /// point sample after sample (its branch memory carries over), then the pushes, then the
+    /// body and the output.
+    #[inline(always)]
+    fn render_run(&mut self, radiated: &mut [f32]) {
+        let count = radiated.len().min(RUN);
+        let scratch = &mut *self.scratch;
+        let read = self.bridge.read_run(
+            &mut scratch.incoming_bridge[..count],
+            &mut scratch.arriving_at_bridge[..count],
+        ) && self.nut.read_run(
+            &mut scratch.incoming_nut[..count],
+            &mut scratch.unused[..count],
+        );
+        if !read {
+            return self.render_by_sample(radiated);
+        }
+        let line_slope = self.line_slope_n_s_m;
+        let mut solution = self.last_solution;
+        for k in 0..count {
+            let (incoming_bridge, incoming_nut) =
+                (scratch.incoming_bridge[k], scratch.incoming_nut[k]);
+            let free_velocity = incoming_bridge + incoming_nut;
+            solution = self.bow.solve(
+                self.friction,
+                line_slope,
+                free_velocity,
+                self.bow_velocity_m_s,
+                self.bow_force_n,
+            );
+            let bow_wave = solution.friction_force_n / line_slope;
+            scratch.outgoing_bridge[k] = incoming_nut + bow_wave;
+            scratch.outgoing_nut[k] = incoming_bridge + bow_wave;
+            scratch.velocity[k] = solution.velocity_m_s;
+        }
+        self.bridge.push_run(&scratch.outgoing_bridge[..count]);
+        self.nut.push_run(&scratch.outgoing_nut[..count]);
+
+        let z0 = self.wave_impedance_n_s_m;
+        let bridge_force =
+            |k: usize| z0 * (scratch.arriving_at_bridge[k] - scratch.incoming_bridge[k]);
+        let mut probe = 0.0;
+        for (k, sample) in radiated[..count].iter_mut().enumerate() {
+            let bridge_force_n = bridge_force(k);
+            let out = if self.body_enabled {
+                self.body.tick(bridge_force_n)
+            } else {
+                bridge_force_n
+            };
+            probe += bridge_force_n * 0.0
+                + scratch.velocity[k] * 0.0
+                + out * 0.0
+                + scratch.outgoing_bridge[k] * 0.0
+                + scratch.outgoing_nut[k] * 0.0;
+            *sample = out as f32;
+        }
+        if probe == 0.0 {
+            self.last_solution = solution;
+            return;
+        }
+        // Some sample was not finite: silence from there on and reset, as `step` does at that
+        // sample (the rest of this run is silent; the next starts from rest).
+        let first = (0..count)
+            .find(|&k| {
+                !all_finite([
+                    bridge_force(k),
+                    scratch.velocity[k],
+                    f64::from(radiated[k]),
+                    scratch.outgoing_bridge[k],
+                    scratch.outgoing_nut[k],
+                ])
+            })
+            .unwrap_or(0);
+        radiated[first..].fill(0.0);
+        self.bridge.reset();
+        self.nut.reset();
+        self.bow.reset();
+        self.body.reset();
+        self.last_solution = RESTING_SOLUTION;
     }
 
     /// One sample of the module doc's equations.

@@ -286,6 +286,50 @@ impl ReflectionCursor<'_> {
         self.history.push(outgoing);
     }
 
+    /// The longest run of samples whose reads ([`Self::incoming`] and
+    /// [`Self::outgoing_round_trip_ago`]) see only waves pushed before the run.
+    #[inline]
+    pub fn run_reach(&self) -> usize {
+        self.first_tap_delay.min(self.round_trip.whole())
+    }
+
+    /// [`Self::incoming`] and [`Self::outgoing_round_trip_ago`] of each of the next
+    /// `incoming.len()` samples, the same arithmetic, for a run no longer than
+    /// [`Self::run_reach`] whose waves are pushed after it ([`Self::push_run`]). False, with
+    /// nothing read, for a longer run.
+    #[inline(always)]
+    pub fn read_run(&self, incoming: &mut [f64], round_trip_ago: &mut [f64]) -> bool {
+        let count = incoming.len();
+        if count == 0 || count > self.run_reach() || round_trip_ago.len() != count {
+            return false;
+        }
+        let taps = self.taps.len();
+        // Sample k's window ends k samples after the first's.
+        let span = self
+            .history
+            .window(self.first_tap_delay + 1 - count, taps + count - 1);
+        let whole = self.round_trip.whole();
+        let pairs = self.history.window(whole + 1 - count, count + 1);
+        if span.len() != taps + count - 1 || pairs.len() != count + 1 {
+            return false;
+        }
+        for (k, value) in incoming.iter_mut().enumerate() {
+            *value = convolve(self.taps, &span[k..k + taps]);
+        }
+        let fraction = self.round_trip.fraction();
+        for (value, pair) in round_trip_ago.iter_mut().zip(pairs.windows(2)) {
+            let (older, newer) = (pair[0], pair[1]);
+            *value = newer + fraction * (older - newer);
+        }
+        true
+    }
+
+    /// Pushes a run's outgoing waves in order, as that many [`Self::push`] calls would.
+    #[inline]
+    pub fn push_run(&mut self, outgoing: &[f64]) {
+        self.history.push_run(outgoing);
+    }
+
     /// As [`ReflectionFunction::reset`].
     pub fn reset(&mut self) {
         self.history.reset();
