@@ -552,6 +552,7 @@ impl<F: FrictionLaw, const G: usize> RoundedRun<'_, F, G> {
     #[inline(always)]
     fn render_run(&mut self, radiated: &mut [f32]) {
         let count = radiated.len().min(RUN);
+        let controls = self.controls();
         let scratch = &mut *self.scratch;
         let read = self.bridge.read_run(
             &mut scratch.incoming_bridge[..count],
@@ -563,22 +564,19 @@ impl<F: FrictionLaw, const G: usize> RoundedRun<'_, F, G> {
         if !read {
             return self.render_by_sample(radiated);
         }
-        let line_slope = self.line_slope_n_s_m;
         let mut solution = self.last_solution;
         for k in 0..count {
-            let (incoming_bridge, incoming_nut) =
-                (scratch.incoming_bridge[k], scratch.incoming_nut[k]);
-            let free_velocity = incoming_bridge + incoming_nut;
-            solution = self.bow.solve(
+            (
+                solution,
+                scratch.outgoing_bridge[k],
+                scratch.outgoing_nut[k],
+            ) = Self::bow_junction(
+                &mut self.bow,
                 self.friction,
-                line_slope,
-                free_velocity,
-                self.bow_velocity_m_s,
-                self.bow_force_n,
+                controls,
+                scratch.incoming_bridge[k],
+                scratch.incoming_nut[k],
             );
-            let bow_wave = solution.friction_force_n / line_slope;
-            scratch.outgoing_bridge[k] = incoming_nut + bow_wave;
-            scratch.outgoing_nut[k] = incoming_bridge + bow_wave;
             scratch.velocity[k] = solution.velocity_m_s;
         }
         self.bridge.push_run(&scratch.outgoing_bridge[..count]);
@@ -627,26 +625,59 @@ impl<F: FrictionLaw, const G: usize> RoundedRun<'_, F, G> {
         self.last_solution = RESTING_SOLUTION;
     }
 
+    /// The bow point of one sample from the waves arriving at it: its solution and the waves it
+    /// sends towards bridge and nut. The bow point and the controls are passed apart from the
+    /// rest of the run so that a run can hold its arrays while it calls this.
+    #[inline(always)]
+    fn bow_junction(
+        bow: &mut BowPoint,
+        friction: &F,
+        controls: [f64; 3],
+        incoming_bridge: f64,
+        incoming_nut: f64,
+    ) -> (BowPointSolution, f64, f64) {
+        let [line_slope, bow_velocity_m_s, bow_force_n] = controls;
+        let free_velocity = incoming_bridge + incoming_nut;
+        let solution = bow.solve(
+            friction,
+            line_slope,
+            free_velocity,
+            bow_velocity_m_s,
+            bow_force_n,
+        );
+        let bow_wave = solution.friction_force_n / line_slope;
+        (
+            solution,
+            incoming_nut + bow_wave,
+            incoming_bridge + bow_wave,
+        )
+    }
+
+    /// The line slope 2Z₀, the bow's velocity and its force, for [`Self::bow_junction`].
+    #[inline(always)]
+    fn controls(&self) -> [f64; 3] {
+        [
+            self.line_slope_n_s_m,
+            self.bow_velocity_m_s,
+            self.bow_force_n,
+        ]
+    }
+
     /// One sample of the module doc's equations.
     #[inline(always)]
     fn step(&mut self) -> BowedOutput {
         let z0 = self.wave_impedance_n_s_m;
-        let line_slope = self.line_slope_n_s_m;
 
         let incoming_bridge = self.bridge.incoming();
         let incoming_nut = self.nut.incoming();
-        let free_velocity = incoming_bridge + incoming_nut;
-
-        let solution = self.bow.solve(
+        let controls = self.controls();
+        let (solution, outgoing_bridge, outgoing_nut) = Self::bow_junction(
+            &mut self.bow,
             self.friction,
-            line_slope,
-            free_velocity,
-            self.bow_velocity_m_s,
-            self.bow_force_n,
+            controls,
+            incoming_bridge,
+            incoming_nut,
         );
-        let bow_wave = solution.friction_force_n / line_slope;
-        let outgoing_bridge = incoming_nut + bow_wave;
-        let outgoing_nut = incoming_bridge + bow_wave;
 
         // Read before pushing: the wave sent towards the bridge one round trip ago.
         let arriving_at_bridge = self.bridge.outgoing_round_trip_ago();
