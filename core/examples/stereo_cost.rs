@@ -3,7 +3,7 @@
 //! `Engine::process_stereo`, alternately five times each; prints the median of each and their
 //! ratio. `cargo run --release -p javari-core --example stereo_cost`.
 
-use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
+use javari_core::engine::{Engine, EngineSettings, TanpuraOutput, TimedEvent};
 use javari_core::tanpura::quality::Quality;
 use std::time::Instant;
 
@@ -23,13 +23,7 @@ fn drone() -> Engine {
 fn seconds(stereo: bool) -> f64 {
     let mut engine = drone();
     let (mut left, mut right) = ([0.0f32; BLOCK], [0.0f32; BLOCK]);
-    let hold = [TimedEvent {
-        offset: 0,
-        event: EngineEvent::NoteOn {
-            note: 50,
-            velocity: 1.0,
-        },
-    }];
+    let hold = [TimedEvent::note_on(0, 50, 1.0)];
     let blocks = (10.0 * RATE) as usize / BLOCK;
     let start = Instant::now();
     for index in 0..blocks {

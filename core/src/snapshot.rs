@@ -407,7 +407,7 @@ impl OutputHistory {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::engine::{pitch, Engine, EngineEvent, EngineSettings, TimedEvent};
+    use crate::engine::{pitch, Engine, EngineSettings, TimedEvent};
     use crate::tanpura::excitation::Pluck;
     use crate::tanpura::fd::FdStringConfig;
     use crate::tanpura::TanpuraVoice;
@@ -647,16 +647,7 @@ pub(crate) mod tests {
         let note = 50;
         let hz = pitch::note_to_hz(note);
         let mut output = vec![0.0f32; 441];
-        engine.process(
-            &[TimedEvent {
-                offset: 0,
-                event: EngineEvent::NoteOn {
-                    note,
-                    velocity: 1.0,
-                },
-            }],
-            &mut output,
-        );
+        engine.process(&[TimedEvent::note_on(0, note, 1.0)], &mut output);
         let mut voice_settings = engine.settings().voice;
         voice_settings.fundamental_hz = hz;
         let mut lone = TanpuraVoice::new(&voice_settings, rate);
@@ -691,20 +682,8 @@ pub(crate) mod tests {
         let mut engine = Engine::new(&EngineSettings::default(), 44_100.0, 4);
         let mut output = vec![0.0f32; 256];
         let events = [
-            TimedEvent {
-                offset: 0,
-                event: EngineEvent::NoteOn {
-                    note: 48,
-                    velocity: 0.1,
-                },
-            },
-            TimedEvent {
-                offset: 10,
-                event: EngineEvent::NoteOn {
-                    note: 55,
-                    velocity: 1.0,
-                },
-            },
+            TimedEvent::note_on(0, 48, 0.1),
+            TimedEvent::note_on(10, 55, 1.0),
         ];
         engine.process(&events, &mut output);
         for _ in 0..8 {

@@ -292,20 +292,14 @@ impl SnapshotReceiver {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::{EngineEvent, EngineSettings, TimedEvent};
+    use crate::engine::{EngineSettings, TimedEvent};
 
     fn engine() -> Engine {
         Engine::new(&EngineSettings::default(), 44_100.0, 4)
     }
 
     fn pluck(note: u8) -> [TimedEvent; 1] {
-        [TimedEvent {
-            offset: 0,
-            event: EngineEvent::NoteOn {
-                note,
-                velocity: 1.0,
-            },
-        }]
+        [TimedEvent::note_on(0, note, 1.0)]
     }
 
     #[test]

@@ -256,13 +256,7 @@ fn non_finite_and_out_of_range_values_are_clamped() {
             calm.drone.enabled = false;
             engine.set_settings(&calm);
             let mut block = [0.0f32; 256];
-            let note = [TimedEvent {
-                offset: 0,
-                event: EngineEvent::NoteOn {
-                    note: 57,
-                    velocity: 0.8,
-                },
-            }];
+            let note = [TimedEvent::note_on(0, 57, 0.8)];
             engine.process(&note, &mut block);
             let mut peak = 0.0f32;
             for block_index in 0..80 {
@@ -333,13 +327,7 @@ fn latency_is_the_same_at_every_tier_and_the_modal_tiers_are_delayed_to_it() {
         modal.voice.quality = quality;
         let mut engine = Engine::new(&modal, 44_100.0, 1);
         let mut output = vec![0.0f32; 256];
-        let pluck = [TimedEvent {
-            offset: 0,
-            event: EngineEvent::NoteOn {
-                note: 57,
-                velocity: 1.0,
-            },
-        }];
+        let pluck = [TimedEvent::note_on(0, 57, 1.0)];
         engine.process(&pluck, &mut output);
         assert!(output[..delay].iter().all(|&x| x == 0.0), "{quality:?}");
         assert!(output[delay] != 0.0, "{quality:?}: silent after the delay");

@@ -3,7 +3,7 @@
 
 use javari_core::bowed::instrument::BOW_HISTORY_SAMPLES;
 use javari_core::bowed::{BowedEvent, BowedInstrument, StringConstants};
-use javari_core::engine::{Engine, EngineEvent, EngineSettings, Instrument, TimedEvent};
+use javari_core::engine::{Engine, EngineSettings, Instrument, TimedEvent};
 use javari_core::snapshot::TanpuraSnapshot;
 
 #[test]
@@ -21,13 +21,7 @@ fn bowed_snapshot_equals_the_instrument_state() {
     twin.set_bow_position(settings.bowed.bow_position);
 
     let mut block = vec![0.0f32; 4410];
-    let events = [TimedEvent {
-        offset: 0,
-        event: EngineEvent::NoteOn {
-            note: 60,
-            velocity: 0.7,
-        },
-    }];
+    let events = [TimedEvent::note_on(0, 60, 0.7)];
     engine.process(&events, &mut block);
     twin.handle(BowedEvent::NoteOn {
         note: 60,

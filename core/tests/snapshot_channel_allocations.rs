@@ -4,7 +4,7 @@
 //! `Javari::process` calls them, run under a counting global allocator that counts only the
 //! audio thread's allocations.
 
-use javari_core::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
+use javari_core::engine::{Engine, EngineSettings, TimedEvent};
 use javari_core::snapshot_channel::{
     Publication, SnapshotChannel, SnapshotPublisher, QUEUE_FRAMES,
 };
@@ -92,13 +92,11 @@ fn run(state: EditorState) -> (u64, [usize; 4], u64) {
     COUNTING.with(|counting| counting.set(true));
     for index in 0..blocks {
         let started = Instant::now();
-        let pluck = [TimedEvent {
-            offset: 17,
-            event: EngineEvent::NoteOn {
-                note: 48 + (index / pluck_every % 5) as u8,
-                velocity: 0.9,
-            },
-        }];
+        let pluck = [TimedEvent::note_on(
+            17,
+            48 + (index / pluck_every % 5) as u8,
+            0.9,
+        )];
         let events: &[TimedEvent] = if index % pluck_every == 0 {
             &pluck
         } else {

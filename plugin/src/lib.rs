@@ -233,13 +233,7 @@ impl Plugin for Javari {
 
         self.events.clear();
         if let Some(note) = self.snapshots.channel().take_audition() {
-            self.events.push(TimedEvent {
-                offset: 0,
-                event: EngineEvent::NoteOn {
-                    note,
-                    velocity: 1.0,
-                },
-            });
+            self.events.push(TimedEvent::note_on(0, note, 1.0));
         }
         while let Some(event) = context.next_event() {
             let offset = event.timing() as usize;

@@ -216,9 +216,14 @@ fn parse_note_name(text: &str) -> Option<i32> {
 const NS_PER_S: f64 = 1e9;
 
 fn millimetres(range_m: (f64, f64)) -> FloatRange {
+    linear((range_m.0 * MM_PER_M, range_m.1 * MM_PER_M))
+}
+
+/// A linear parameter range over an engine's `(min, max)` range.
+fn linear(range: (f64, f64)) -> FloatRange {
     FloatRange::Linear {
-        min: (range_m.0 * MM_PER_M) as f32,
-        max: (range_m.1 * MM_PER_M) as f32,
+        min: range.0 as f32,
+        max: range.1 as f32,
     }
 }
 
@@ -240,23 +245,13 @@ impl Default for DroneStringParams {
             fine_tune_cents: FloatParam::new(
                 "String fine tuning",
                 0.0,
-                FloatRange::Linear {
-                    min: STRING_FINE_TUNE_RANGE_CENTS.0 as f32,
-                    max: STRING_FINE_TUNE_RANGE_CENTS.1 as f32,
-                },
+                linear(STRING_FINE_TUNE_RANGE_CENTS),
             )
             .with_unit(" cents")
             .with_step_size(0.1),
-            level_db: FloatParam::new(
-                "String level",
-                0.0,
-                FloatRange::Linear {
-                    min: STRING_LEVEL_RANGE_DB.0 as f32,
-                    max: STRING_LEVEL_RANGE_DB.1 as f32,
-                },
-            )
-            .with_unit(" dB")
-            .with_step_size(0.1),
+            level_db: FloatParam::new("String level", 0.0, linear(STRING_LEVEL_RANGE_DB))
+                .with_unit(" dB")
+                .with_step_size(0.1),
             thread_offset_mm: FloatParam::new(
                 "String thread offset",
                 0.0,
@@ -454,70 +449,32 @@ impl Default for JavariParams {
             // Live by default: a DAW needs real time; the renderer defaults to Reference.
             quality: EnumParam::new("Quality", QualityChoice::Live),
             tanpura_output: EnumParam::new("Tanpura output", TanpuraOutputChoice::Radiated),
-            output_gain_db: FloatParam::new(
-                "Output gain",
-                0.0,
-                FloatRange::Linear {
-                    min: OUTPUT_GAIN_RANGE_DB.0 as f32,
-                    max: OUTPUT_GAIN_RANGE_DB.1 as f32,
-                },
-            )
-            .with_unit(" dB")
-            .with_step_size(0.1),
+            output_gain_db: FloatParam::new("Output gain", 0.0, linear(OUTPUT_GAIN_RANGE_DB))
+                .with_unit(" dB")
+                .with_step_size(0.1),
             drone_enabled: BoolParam::new("Drone", false),
             drone_first_string: EnumParam::new("First string", FirstStringChoice::Pa),
             drone_tempo_sync: BoolParam::new("Drone tempo sync", true),
-            drone_tempo_bpm: FloatParam::new(
-                "Drone tempo",
-                60.0,
-                FloatRange::Linear {
-                    min: TEMPO_RANGE_BPM.0 as f32,
-                    max: TEMPO_RANGE_BPM.1 as f32,
-                },
-            )
-            .with_unit(" bpm")
-            .with_step_size(0.1),
-            reference_a4_hz: FloatParam::new(
-                "Reference A4",
-                A4_HZ as f32,
-                FloatRange::Linear {
-                    min: A4_RANGE_HZ.0 as f32,
-                    max: A4_RANGE_HZ.1 as f32,
-                },
-            )
-            .with_unit(" Hz")
-            .with_step_size(0.1),
-            fine_tune_cents: FloatParam::new(
-                "Fine tuning",
-                0.0,
-                FloatRange::Linear {
-                    min: FINE_TUNE_RANGE_CENTS.0 as f32,
-                    max: FINE_TUNE_RANGE_CENTS.1 as f32,
-                },
-            )
-            .with_unit(" cents")
-            .with_step_size(0.1),
+            drone_tempo_bpm: FloatParam::new("Drone tempo", 60.0, linear(TEMPO_RANGE_BPM))
+                .with_unit(" bpm")
+                .with_step_size(0.1),
+            reference_a4_hz: FloatParam::new("Reference A4", A4_HZ as f32, linear(A4_RANGE_HZ))
+                .with_unit(" Hz")
+                .with_step_size(0.1),
+            fine_tune_cents: FloatParam::new("Fine tuning", 0.0, linear(FINE_TUNE_RANGE_CENTS))
+                .with_unit(" cents")
+                .with_step_size(0.1),
             drone_pattern: EnumParam::new("Drone strings", DronePatternChoice::Four),
             drone_spacing_beats: FloatParam::new(
                 "Pluck spacing",
                 1.0,
-                FloatRange::Linear {
-                    min: PLUCK_SPACING_RANGE_BEATS.0 as f32,
-                    max: PLUCK_SPACING_RANGE_BEATS.1 as f32,
-                },
+                linear(PLUCK_SPACING_RANGE_BEATS),
             )
             .with_unit(" beats")
             .with_step_size(0.05),
-            drone_pause_beats: FloatParam::new(
-                "Cycle pause",
-                1.0,
-                FloatRange::Linear {
-                    min: CYCLE_PAUSE_RANGE_BEATS.0 as f32,
-                    max: CYCLE_PAUSE_RANGE_BEATS.1 as f32,
-                },
-            )
-            .with_unit(" beats")
-            .with_step_size(0.05),
+            drone_pause_beats: FloatParam::new("Cycle pause", 1.0, linear(CYCLE_PAUSE_RANGE_BEATS))
+                .with_unit(" beats")
+                .with_step_size(0.05),
             drone_humanize_ms: FloatParam::new(
                 "Humanise timing",
                 0.0,

@@ -102,7 +102,7 @@ fn run(shared: &Shared) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use javari_core::engine::{EngineEvent, EngineSettings, TimedEvent};
+    use javari_core::engine::{EngineSettings, TimedEvent};
     use javari_core::tanpura::quality::Quality;
 
     #[test]
@@ -112,13 +112,7 @@ mod tests {
         let mut engine = Engine::new(&settings, 44_100.0, 2);
         let worker = TuningWorker::start();
         let mut output = [0.0f32; 64];
-        let pluck = [TimedEvent {
-            offset: 0,
-            event: EngineEvent::NoteOn {
-                note: 57,
-                velocity: 1.0,
-            },
-        }];
+        let pluck = [TimedEvent::note_on(0, 57, 1.0)];
         engine.process(&pluck, &mut output);
         worker.exchange(&mut engine);
         let deadline = std::time::Instant::now() + Duration::from_secs(120);

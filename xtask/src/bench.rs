@@ -180,14 +180,8 @@ impl<V: BowedVoice> BowedNote<V> {
             stats: NewtonStats::default(),
         }
     }
-}
 
-/// A scene played once before it is timed, then put back at rest.
-trait WarmUp {
-    fn play_untimed(&mut self, seconds: f64);
-}
-
-impl<V: BowedVoice> WarmUp for BowedNote<V> {
+    /// Plays the note for `seconds` untimed, then puts the voice back at rest.
     fn play_untimed(&mut self, seconds: f64) {
         let mut block = [0.0f32; BLOCK];
         for _ in 0..(seconds * SAMPLE_RATE) as usize / BLOCK {
@@ -394,9 +388,8 @@ pub fn run_all(seconds: f64) -> Vec<BenchResult> {
     // session: the bow table 2000× real time on its first 3 s, 2400× on its third). Each voice
     // plays the note once untimed and is reset: the figure is a voice's steady cost, as a host
     // calling it block after block sees it. The tanpura scenes run for seconds and need none.
-    for warm_up in [&mut rounded as &mut dyn WarmUp, &mut table] {
-        warm_up.play_untimed(seconds);
-    }
+    rounded.play_untimed(seconds);
+    table.play_untimed(seconds);
     let reference = measure(
         &mut rounded,
         seconds,

@@ -357,13 +357,7 @@ impl SoakScene {
             note: DRONE_NOTE,
             release_block: u64::MAX,
         });
-        scene.events[0] = TimedEvent {
-            offset: 0,
-            event: EngineEvent::NoteOn {
-                note: DRONE_NOTE,
-                velocity: 0.8,
-            },
-        };
+        scene.events[0] = TimedEvent::note_on(0, DRONE_NOTE, 0.8);
         scene.next_note_block = seconds_to_blocks(1.0);
         scene
     }
@@ -758,13 +752,7 @@ pub fn age_probe(quality: Quality, flush_denormals: bool) -> AgeProbe {
     settings.voice.quality = quality;
     settings.voice.gamma_per_s = 0.0;
     let mut engine = Engine::new(&settings, SAMPLE_RATE, DEFAULT_VOICE_COUNT);
-    let pluck = [TimedEvent {
-        offset: 0,
-        event: EngineEvent::NoteOn {
-            note: 57,
-            velocity: 1.0,
-        },
-    }];
+    let pluck = [TimedEvent::note_on(0, 57, 1.0)];
     let mut output = [0.0f32; BLOCK];
     let (fresh_from, aged_from, span) = (
         seconds_to_blocks(1.0),

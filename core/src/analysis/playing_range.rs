@@ -5,7 +5,7 @@
 //! linearisation ([`render`]) or, as `cargo xtask render` and the plugin tune it, by its
 //! sustained pitch as played ([`calibrate`], [`render_as_played`]).
 
-use crate::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
+use crate::engine::{Engine, EngineSettings, TimedEvent};
 use crate::tanpura::as_played::{Calibration, CalibrationRequest};
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::quality::Quality;
@@ -135,13 +135,11 @@ fn render_tuned(
     let samples = (seconds * sample_rate_hz).round() as usize;
     let mut output = Vec::with_capacity(samples);
     let mut block = [0.0f32; BLOCK];
-    let note_on = [TimedEvent {
-        offset: 0,
-        event: EngineEvent::NoteOn {
-            note: point.key,
-            velocity: point.velocity as f32 / 127.0,
-        },
-    }];
+    let note_on = [TimedEvent::note_on(
+        0,
+        point.key,
+        point.velocity as f32 / 127.0,
+    )];
     while output.len() < samples {
         let length = BLOCK.min(samples - output.len());
         let events: &[TimedEvent] = if output.is_empty() { &note_on } else { &[] };

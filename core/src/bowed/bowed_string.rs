@@ -502,8 +502,6 @@ struct RunScratch {
     incoming_bridge: [f64; RUN],
     incoming_nut: [f64; RUN],
     arriving_at_bridge: [f64; RUN],
-    /// The nut's round-trip read, which the voice does not use.
-    unused: [f64; RUN],
     outgoing_bridge: [f64; RUN],
     outgoing_nut: [f64; RUN],
     velocity: [f64; RUN],
@@ -515,7 +513,6 @@ impl Default for RunScratch {
             incoming_bridge: [0.0; RUN],
             incoming_nut: [0.0; RUN],
             arriving_at_bridge: [0.0; RUN],
-            unused: [0.0; RUN],
             outgoing_bridge: [0.0; RUN],
             outgoing_nut: [0.0; RUN],
             velocity: [0.0; RUN],
@@ -554,13 +551,13 @@ impl<F: FrictionLaw, const G: usize> RoundedRun<'_, F, G> {
         let count = radiated.len().min(RUN);
         let controls = self.controls();
         let scratch = &mut *self.scratch;
-        let read = self.bridge.read_run(
-            &mut scratch.incoming_bridge[..count],
-            &mut scratch.arriving_at_bridge[..count],
-        ) && self.nut.read_run(
-            &mut scratch.incoming_nut[..count],
-            &mut scratch.unused[..count],
-        );
+        let read = self
+            .bridge
+            .incoming_run(&mut scratch.incoming_bridge[..count])
+            && self
+                .bridge
+                .round_trip_run(&mut scratch.arriving_at_bridge[..count])
+            && self.nut.incoming_run(&mut scratch.incoming_nut[..count]);
         if !read {
             return self.render_by_sample(radiated);
         }

@@ -147,6 +147,28 @@ impl DelayCursor<'_> {
     }
 
     /// As [`DelayHistory::window`].
+    /// Reads `into.len()` consecutive samples at `delay`, as that many [`Self::read`] calls
+    /// between pushes would, for a run whose values are pushed after it
+    /// ([`Self::push_run`]); false (nothing read) when the delay's whole samples are fewer than
+    /// the run, so that a read would need a value of the run itself.
+    #[inline(always)]
+    pub fn read_run(&self, delay: &FractionalDelay, into: &mut [f64]) -> bool {
+        let count = into.len();
+        if count == 0 || delay.whole < count {
+            return false;
+        }
+        // Sample k reads the pair k samples after the first's.
+        let pairs = self.window(delay.whole + 1 - count, count + 1);
+        if pairs.len() != count + 1 {
+            return false;
+        }
+        for (value, pair) in into.iter_mut().zip(pairs.windows(2)) {
+            let (older, newer) = (pair[0], pair[1]);
+            *value = newer + delay.fraction * (older - newer);
+        }
+        true
+    }
+
     /// Pushes `values` in order, as that many [`Self::push`] calls would.
     #[inline]
     pub fn push_run(&mut self, values: &[f64]) {

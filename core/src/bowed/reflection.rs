@@ -293,14 +293,13 @@ impl ReflectionCursor<'_> {
         self.first_tap_delay.min(self.round_trip.whole())
     }
 
-    /// [`Self::incoming`] and [`Self::outgoing_round_trip_ago`] of each of the next
-    /// `incoming.len()` samples, the same arithmetic, for a run no longer than
-    /// [`Self::run_reach`] whose waves are pushed after it ([`Self::push_run`]). False, with
-    /// nothing read, for a longer run.
+    /// [`Self::incoming`] of each of the next `into.len()` samples, the same arithmetic, for a
+    /// run no longer than [`Self::run_reach`] whose waves are pushed after it
+    /// ([`Self::push_run`]). False, with nothing read, for a longer run.
     #[inline(always)]
-    pub fn read_run(&self, incoming: &mut [f64], round_trip_ago: &mut [f64]) -> bool {
-        let count = incoming.len();
-        if count == 0 || count > self.run_reach() || round_trip_ago.len() != count {
+    pub fn incoming_run(&self, into: &mut [f64]) -> bool {
+        let count = into.len();
+        if count == 0 || count > self.first_tap_delay {
             return false;
         }
         let taps = self.taps.len();
@@ -308,20 +307,20 @@ impl ReflectionCursor<'_> {
         let span = self
             .history
             .window(self.first_tap_delay + 1 - count, taps + count - 1);
-        let whole = self.round_trip.whole();
-        let pairs = self.history.window(whole + 1 - count, count + 1);
-        if span.len() != taps + count - 1 || pairs.len() != count + 1 {
+        if span.len() != taps + count - 1 {
             return false;
         }
-        for (k, value) in incoming.iter_mut().enumerate() {
+        for (k, value) in into.iter_mut().enumerate() {
             *value = convolve(self.taps, &span[k..k + taps]);
         }
-        let fraction = self.round_trip.fraction();
-        for (value, pair) in round_trip_ago.iter_mut().zip(pairs.windows(2)) {
-            let (older, newer) = (pair[0], pair[1]);
-            *value = newer + fraction * (older - newer);
-        }
         true
+    }
+
+    /// [`Self::outgoing_round_trip_ago`] of each of the next `into.len()` samples, on the
+    /// terms of [`Self::incoming_run`].
+    #[inline(always)]
+    pub fn round_trip_run(&self, into: &mut [f64]) -> bool {
+        self.history.read_run(&self.round_trip, into)
     }
 
     /// Pushes a run's outgoing waves in order, as that many [`Self::push`] calls would.

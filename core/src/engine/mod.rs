@@ -423,6 +423,16 @@ pub struct TimedEvent {
     pub event: EngineEvent,
 }
 
+impl TimedEvent {
+    /// A note-on of `note` at `velocity` (0–1) at sample `offset` of the block.
+    pub fn note_on(offset: usize, note: u8, velocity: f32) -> Self {
+        Self {
+            offset,
+            event: EngineEvent::NoteOn { note, velocity },
+        }
+    }
+}
+
 /// What a voice currently is: which string of the instrument it plays.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum StringKey {

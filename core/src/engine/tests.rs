@@ -93,13 +93,7 @@ fn note_off_does_not_stop_a_ringing_string() {
 #[test]
 fn stealing_takes_the_quietest_then_the_oldest_voice() {
     let mut engine = Engine::new(&EngineSettings::default(), RATE, 2);
-    let quiet = TimedEvent {
-        offset: 0,
-        event: EngineEvent::NoteOn {
-            note: 60,
-            velocity: 0.1,
-        },
-    };
+    let quiet = TimedEvent::note_on(0, 60, 0.1);
     // C4 quietly, then E4 loudly 0.3 s later; after another 0.3 s G4 needs a voice.
     run(&mut engine, &[quiet], 13_230);
     run(&mut engine, &[note_on(0, 64)], 13_230);
@@ -198,13 +192,7 @@ fn reset_renders_exactly_as_a_new_engine() {
 #[test]
 fn snapshot_equals_the_loudest_string_exactly() {
     let mut engine = Engine::new(&EngineSettings::default(), RATE, 4);
-    let quiet = TimedEvent {
-        offset: 0,
-        event: EngineEvent::NoteOn {
-            note: 48,
-            velocity: 0.1,
-        },
-    };
+    let quiet = TimedEvent::note_on(0, 48, 0.1);
     run(&mut engine, &[quiet, note_on(10, 55)], 300);
     let mut snapshot = crate::snapshot::TanpuraSnapshot::default();
     for _ in 0..4 {
