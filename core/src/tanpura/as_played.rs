@@ -26,7 +26,7 @@
 //! Where the string at rest just touches the crest the two ends can sound 10 cents apart (a soft
 //! pluck stays on the crest, a firm one lifts it off), and centring them is all a tension can do.
 //! Moving the thread 1 mm settles those notes, but they sit at the jawari's sweet spot and the
-//! move takes 7–13 dB off their level above 2 kHz (`examples/jawari_moves.rs`, README), so the
+//! move takes 6–13 dB off their level above 2 kHz (`examples/jawari_moves.rs`, README), so the
 //! calibration leaves the thread where the player put it.
 //!
 //! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the
