@@ -1,7 +1,8 @@
 //! What retuning a ringing string costs per tier (`TanpuraVoice::set_settings`): 200 changes of
 //! the thread position (a new rest state and the tuning passes), then 200 of γ only, each
 //! followed by one output sample, against the cost of one sample and a 64-sample block's
-//! deadline. `cargo run --release -p javari-core --example retune_cost` (docs/performance.md).
+//! deadline. `cargo run --release -p javari-core --example retune_cost [TIER ...]`
+//! (docs/performance.md); with tier names (draft, live, studio) only those tiers.
 
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
@@ -26,7 +27,12 @@ fn main() {
         "deadline of a 64-sample block at 44.1 kHz: {:.0} µs",
         64.0 / RATE * 1e6
     );
-    for quality in [Quality::Draft, Quality::Live, Quality::Studio] {
+    let chosen: Vec<String> = std::env::args().skip(1).collect();
+    let tiers = [Quality::Draft, Quality::Live, Quality::Studio];
+    for quality in tiers
+        .into_iter()
+        .filter(|quality| chosen.is_empty() || chosen.iter().any(|name| name == quality.name()))
+    {
         let settings = VoiceSettings {
             fundamental_hz: 146.8,
             quality,

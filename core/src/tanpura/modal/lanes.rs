@@ -229,6 +229,85 @@ impl<T: Real> WithSimd for Dots<'_, T> {
     }
 }
 
+/// Dot products of several rows of a matrix with two vectors:
+/// `out_x[j] = matrix[rows[j]] · x`, `out_y[j] = matrix[rows[j]] · y`. Each row is read once for
+/// both; every sum runs in the order of [`Dots`] (even and odd registers apart), so each result
+/// equals the one [`Dots`] gives bit for bit.
+struct DotsPair<'a, T: Real> {
+    matrix: &'a [T],
+    stride: usize,
+    rows: &'a [usize],
+    x: &'a [T],
+    y: &'a [T],
+    out_x: &'a mut [f64],
+    out_y: &'a mut [f64],
+}
+
+impl<T: Real> WithSimd for DotsPair<'_, T> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let length = self.x.len();
+        let x = T::lanes::<S>(self.x);
+        let y = &T::lanes::<S>(&self.y[..length])[..x.len()];
+        let row = |index: usize| {
+            let start = index * self.stride;
+            T::lanes::<S>(&self.matrix[start..start + length])
+        };
+        let zero = T::splat(simd, T::default());
+        // Two rows per pass: eight multiply-add chains (two rows, two vectors, even and odd).
+        let mut rows = self.rows.chunks_exact(2);
+        let mut out_x = self.out_x.chunks_exact_mut(2);
+        let mut out_y = self.out_y.chunks_exact_mut(2);
+        for ((indices, out_x), out_y) in (&mut rows).zip(&mut out_x).zip(&mut out_y) {
+            let (r0, r1) = (row(indices[0]), row(indices[1]));
+            let mut even = [zero; 4];
+            let mut odd = [zero; 4];
+            let pairs = x
+                .chunks_exact(2)
+                .zip(y.chunks_exact(2))
+                .zip(r0.chunks_exact(2))
+                .zip(r1.chunks_exact(2));
+            for (((xk, yk), a), b) in pairs {
+                even[0] = T::mul_add(simd, a[0], xk[0], even[0]);
+                even[1] = T::mul_add(simd, b[0], xk[0], even[1]);
+                even[2] = T::mul_add(simd, a[0], yk[0], even[2]);
+                even[3] = T::mul_add(simd, b[0], yk[0], even[3]);
+                odd[0] = T::mul_add(simd, a[1], xk[1], odd[0]);
+                odd[1] = T::mul_add(simd, b[1], xk[1], odd[1]);
+                odd[2] = T::mul_add(simd, a[1], yk[1], odd[2]);
+                odd[3] = T::mul_add(simd, b[1], yk[1], odd[3]);
+            }
+            let total = |j: usize| T::sum(simd, T::add(simd, even[j], odd[j])).to_f64();
+            out_x[0] = total(0);
+            out_x[1] = total(1);
+            out_y[0] = total(2);
+            out_y[1] = total(3);
+        }
+        let remainder = rows
+            .remainder()
+            .iter()
+            .zip(out_x.into_remainder())
+            .zip(out_y.into_remainder());
+        for ((&index, out_x), out_y) in remainder {
+            let mut sums = [zero; 4];
+            let pairs = x
+                .chunks_exact(2)
+                .zip(y.chunks_exact(2))
+                .zip(row(index).chunks_exact(2));
+            for ((xk, yk), a) in pairs {
+                sums[0] = T::mul_add(simd, a[0], xk[0], sums[0]);
+                sums[1] = T::mul_add(simd, a[1], xk[1], sums[1]);
+                sums[2] = T::mul_add(simd, a[0], yk[0], sums[2]);
+                sums[3] = T::mul_add(simd, a[1], yk[1], sums[3]);
+            }
+            *out_x = T::sum(simd, T::add(simd, sums[0], sums[1])).to_f64();
+            *out_y = T::sum(simd, T::add(simd, sums[2], sums[3])).to_f64();
+        }
+    }
+}
+
 /// Rows of Ψ whose forces the fused update keeps in registers; further rows go through memory.
 const REGISTER_ROWS: usize = 8;
 
@@ -236,7 +315,7 @@ const REGISTER_ROWS: usize = 8;
 /// step, in one pass over the modes: `s += b Σ_j ΔF_j Ψ_j`, `r += s`, `p = s − p`, then the next
 /// free step `s ← a p − b r`. Returns the nut force `c · r` after the step and `‖s_next‖²`. The
 /// modal force of the first [`REGISTER_ROWS`] rows never leaves the registers, so a pass stores
-/// only r, p and the next free step (and the whole step when `whole_step` is given).
+/// only r, p, the next free step and the whole step.
 struct AdvanceAndPrepare<'a, T: Real> {
     a: &'a [T],
     b: &'a [T],
@@ -245,12 +324,85 @@ struct AdvanceAndPrepare<'a, T: Real> {
     stride: usize,
     rows: &'a [usize],
     forces: &'a [T],
-    /// Scratch of the arrays' length for the rows beyond [`REGISTER_ROWS`].
-    overflow: &'a mut [T],
+    /// The arrays' length: scratch for the rows beyond [`REGISTER_ROWS`] on entry, the whole
+    /// step `s + b Σ_j ΔF_j Ψ_j` on return.
+    work: &'a mut [T],
     s: &'a mut [T],
     r: &'a mut [T],
     p: &'a mut [T],
-    whole_step: Option<&'a mut [T]>,
+}
+
+impl<T: Real> AdvanceAndPrepare<'_, T> {
+    /// The pass with `ROWS` rows in registers (and, if `SPILLS`, the rest summed into `work`
+    /// first). The row count is a constant so that the force sum unrolls and every slice has the
+    /// registers' count as its length: no bounds check and no loop counter inside the pass. The
+    /// nut force and the norm keep one accumulator for the even registers and one for the odd.
+    #[inline(always)]
+    fn run<S: Simd, const ROWS: usize, const SPILLS: bool>(self, simd: S) -> (f64, f64) {
+        let zero = T::splat(simd, T::default());
+        let length = self.s.len();
+        let s = T::lanes_mut::<S>(self.s);
+        let registers = s.len();
+        let shape = |row: usize| {
+            let start = row * self.stride;
+            &T::lanes::<S>(&self.matrix[start..start + length])[..registers]
+        };
+        let mut rows: [&[T::Lanes<S>]; ROWS] = [&[]; ROWS];
+        let mut forces = [zero; ROWS];
+        for j in 0..ROWS {
+            rows[j] = shape(self.rows[j]);
+            forces[j] = T::splat(simd, self.forces[j]);
+        }
+        let work = &mut T::lanes_mut::<S>(self.work)[..registers];
+        if SPILLS {
+            work.fill(zero);
+            for (&row, force) in self.rows[ROWS..].iter().zip(&self.forces[ROWS..]) {
+                let force = T::splat(simd, *force);
+                for (sum, shape) in work.iter_mut().zip(shape(row)) {
+                    *sum = T::mul_add(simd, *shape, force, *sum);
+                }
+            }
+        }
+        let a = &T::lanes::<S>(self.a)[..registers];
+        let b = &T::lanes::<S>(self.b)[..registers];
+        let c = &T::lanes::<S>(self.c)[..registers];
+        let r = &mut T::lanes_mut::<S>(self.r)[..registers];
+        let p = &mut T::lanes_mut::<S>(self.p)[..registers];
+        // One register of modes, written out twice below (a closure would not inherit the
+        // kernel's target features and would not be inlined).
+        macro_rules! advance {
+            ($v:expr, $nut:ident, $norm:ident) => {{
+                let v = $v;
+                let mut force = if SPILLS { work[v] } else { zero };
+                for j in 0..ROWS {
+                    force = T::mul_add(simd, rows[j][v], forces[j], force);
+                }
+                let step = T::mul_add(simd, b[v], force, s[v]);
+                work[v] = step;
+                let displacement = T::add(simd, r[v], step);
+                let velocity = T::sub(simd, step, p[v]);
+                r[v] = displacement;
+                p[v] = velocity;
+                $nut = T::mul_add(simd, c[v], displacement, $nut);
+                let next = T::sub(
+                    simd,
+                    T::mul(simd, a[v], velocity),
+                    T::mul(simd, b[v], displacement),
+                );
+                s[v] = next;
+                $norm = T::mul_add(simd, next, next, $norm);
+            }};
+        }
+        let (mut nut_even, mut nut_odd, mut norm_even, mut norm_odd) = (zero, zero, zero, zero);
+        for pair in 0..registers / 2 {
+            advance!(2 * pair, nut_even, norm_even);
+            advance!(2 * pair + 1, nut_odd, norm_odd);
+        }
+        (
+            T::sum(simd, T::add(simd, nut_even, nut_odd)).to_f64(),
+            T::sum(simd, T::add(simd, norm_even, norm_odd)).to_f64(),
+        )
+    }
 }
 
 impl<T: Real> WithSimd for AdvanceAndPrepare<'_, T> {
@@ -258,72 +410,18 @@ impl<T: Real> WithSimd for AdvanceAndPrepare<'_, T> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) -> (f64, f64) {
-        let zero = T::splat(simd, T::default());
-        let length = self.s.len();
-        let shape = |row: usize| {
-            let start = row * self.stride;
-            T::lanes::<S>(&self.matrix[start..start + length])
-        };
-        let head = self.rows.len().min(REGISTER_ROWS);
-        let mut head_rows: [&[T::Lanes<S>]; REGISTER_ROWS] = [&[]; REGISTER_ROWS];
-        let mut head_forces = [zero; REGISTER_ROWS];
-        for j in 0..head {
-            head_rows[j] = shape(self.rows[j]);
-            head_forces[j] = T::splat(simd, self.forces[j]);
+        match self.rows.len() {
+            0 => self.run::<S, 0, false>(simd),
+            1 => self.run::<S, 1, false>(simd),
+            2 => self.run::<S, 2, false>(simd),
+            3 => self.run::<S, 3, false>(simd),
+            4 => self.run::<S, 4, false>(simd),
+            5 => self.run::<S, 5, false>(simd),
+            6 => self.run::<S, 6, false>(simd),
+            7 => self.run::<S, 7, false>(simd),
+            8 => self.run::<S, 8, false>(simd),
+            _ => self.run::<S, REGISTER_ROWS, true>(simd),
         }
-        let overflow = T::lanes_mut::<S>(self.overflow);
-        let spills = self.rows.len() > REGISTER_ROWS;
-        if spills {
-            overflow.fill(zero);
-            for (&row, force) in self.rows[REGISTER_ROWS..]
-                .iter()
-                .zip(&self.forces[REGISTER_ROWS..])
-            {
-                let force = T::splat(simd, *force);
-                for (sum, shape) in overflow.iter_mut().zip(shape(row)) {
-                    *sum = T::mul_add(simd, *shape, force, *sum);
-                }
-            }
-        }
-        let (a, b, c) = (
-            T::lanes::<S>(self.a),
-            T::lanes::<S>(self.b),
-            T::lanes::<S>(self.c),
-        );
-        let s = T::lanes_mut::<S>(self.s);
-        let r = T::lanes_mut::<S>(self.r);
-        let p = T::lanes_mut::<S>(self.p);
-        let mut whole_step = self.whole_step.map(|w| T::lanes_mut::<S>(w));
-        // Two accumulators each for the nut force and the norm (the arrays are register pairs).
-        let mut nut = [zero; 2];
-        let mut norm = [zero; 2];
-        for v in 0..s.len() {
-            let mut force = if spills { overflow[v] } else { zero };
-            for j in 0..head {
-                force = T::mul_add(simd, head_rows[j][v], head_forces[j], force);
-            }
-            let step = T::mul_add(simd, b[v], force, s[v]);
-            if let Some(whole_step) = whole_step.as_deref_mut() {
-                whole_step[v] = step;
-            }
-            let displacement = T::add(simd, r[v], step);
-            let velocity = T::sub(simd, step, p[v]);
-            r[v] = displacement;
-            p[v] = velocity;
-            let lane = v % 2;
-            nut[lane] = T::mul_add(simd, c[v], displacement, nut[lane]);
-            let next = T::sub(
-                simd,
-                T::mul(simd, a[v], velocity),
-                T::mul(simd, b[v], displacement),
-            );
-            s[v] = next;
-            norm[lane] = T::mul_add(simd, next, next, norm[lane]);
-        }
-        (
-            T::sum(simd, T::add(simd, nut[0], nut[1])).to_f64(),
-            T::sum(simd, T::add(simd, norm[0], norm[1])).to_f64(),
-        )
     }
 }
 
@@ -353,9 +451,35 @@ impl Kernels {
         });
     }
 
-    /// `s += b Σ_j forces_j matrix[rows_j]`, `r += s`, `p = s − p` (the whole step into
-    /// `whole_step` if given), then the next free step `s ← a p − b r`; returns `(c · r, ‖s‖²)`
-    /// after the step. `overflow` is scratch of the arrays' length.
+    /// `out_x[j] = matrix[rows[j]] · x` and `out_y[j] = matrix[rows[j]] · y`, each row read once;
+    /// bit for bit what two calls of [`Kernels::dots`] give.
+    #[allow(clippy::too_many_arguments)]
+    pub fn dots_pair<T: Real>(
+        &self,
+        matrix: &[T],
+        stride: usize,
+        rows: &[usize],
+        x: &[T],
+        y: &[T],
+        out_x: &mut [f64],
+        out_y: &mut [f64],
+    ) {
+        debug_assert!(out_x.len() >= rows.len() && out_y.len() >= rows.len());
+        debug_assert!(x.len() <= stride && y.len() >= x.len());
+        self.arch.dispatch(DotsPair {
+            matrix,
+            stride,
+            rows,
+            x,
+            y,
+            out_x,
+            out_y,
+        });
+    }
+
+    /// `s += b Σ_j forces_j matrix[rows_j]`, `r += s`, `p = s − p`, then the next free step
+    /// `s ← a p − b r`; returns `(c · r, ‖s‖²)` after the step. `work` (the arrays' length) holds
+    /// the whole step `s + b Σ_j forces_j matrix[rows_j]` on return.
     #[allow(clippy::too_many_arguments)]
     pub fn advance_and_prepare<T: Real>(
         &self,
@@ -366,11 +490,10 @@ impl Kernels {
         stride: usize,
         rows: &[usize],
         forces: &[T],
-        overflow: &mut [T],
+        work: &mut [T],
         s: &mut [T],
         r: &mut [T],
         p: &mut [T],
-        whole_step: Option<&mut [T]>,
     ) -> (f64, f64) {
         debug_assert!(forces.len() >= rows.len());
         self.arch.dispatch(AdvanceAndPrepare {
@@ -381,11 +504,10 @@ impl Kernels {
             stride,
             rows,
             forces,
-            overflow,
+            work,
             s,
             r,
             p,
-            whole_step,
         })
     }
 }
@@ -421,12 +543,22 @@ mod tests {
             let plain: f64 = row.iter().zip(&s).map(|(x, y)| x * y).sum();
             assert!((dots[j] - plain).abs() < 1e-13, "row {j}");
         }
+        // The paired kernel gives each of the two dot products bit for bit, for an even and an
+        // odd number of rows.
+        let mut dots_r = vec![0.0; rows.len()];
+        kernels.dots(&matrix, n, &all, &r, &mut dots_r);
+        for count in [rows.len() - 1, rows.len()] {
+            let (mut out_s, mut out_r) = (vec![0.0; count], vec![0.0; count]);
+            kernels.dots_pair(&matrix, n, &all[..count], &s, &r, &mut out_s, &mut out_r);
+            assert_eq!(out_s, dots[..count]);
+            assert_eq!(out_r, dots_r[..count]);
+        }
 
         // Three rows stay in registers; eleven spill the last three through memory.
         for count in [3, 11] {
             let forces: Vec<f64> = (0..count).map(|j| 0.3 - 0.17 * j as f64).collect();
             let (mut s2, mut r2, mut p2) = (s.clone(), r.clone(), p.clone());
-            let (mut scratch, mut whole) = (vec![0.0; n], vec![0.0; n]);
+            let mut whole = vec![0.0; n];
             let (nut, norm) = kernels.advance_and_prepare(
                 &a,
                 &b,
@@ -435,11 +567,10 @@ mod tests {
                 n,
                 &all[..count],
                 &forces,
-                &mut scratch,
+                &mut whole,
                 &mut s2,
                 &mut r2,
                 &mut p2,
-                Some(&mut whole),
             );
             let (mut plain_nut, mut plain_norm) = (0.0, 0.0);
             for k in 0..n {

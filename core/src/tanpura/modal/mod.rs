@@ -197,7 +197,7 @@ pub struct ModalString<T: Real> {
     step: Vec<T>,
     /// ‖s_free‖₂², for the far points' bounds.
     free_step_norm_squared: f64,
-    /// The whole step of the last step, kept only when the losses are booked.
+    /// The whole step of the last step (written by every step; the loss ledger reads it).
     whole_step: Vec<T>,
     modal_force: Vec<T>,
     /// Ψ rows in T, `points.capacity() × MODE_CAPACITY` (the force projection).
@@ -324,7 +324,8 @@ impl<T: Real> ModalString<T> {
             config.string.left_support_m,
             config.string.length_m,
         );
-        self.points.couple(&self.modes, config.static_flexibility);
+        self.points
+            .couple(&self.modes, config.static_flexibility, &self.kernels);
         self.lanes = self.modes.count().div_ceil(LANE_PADDING) * LANE_PADDING;
         for k in 0..MODE_CAPACITY {
             self.a[k] = T::from_f64(self.modes.a[k]);
@@ -457,8 +458,19 @@ impl<T: Real> ModalString<T> {
             step_norm,
             &self.config.newton,
             |indices, gaps, free_steps| {
-                exact_gaps(kernels, shapes, lanes, rest_gaps, indices, modal, gaps);
-                kernels.dots(shapes, MODE_CAPACITY, indices, &step[..lanes], free_steps);
+                let (modal, step) = (&modal[..lanes], &step[..lanes]);
+                kernels.dots_pair(
+                    shapes,
+                    MODE_CAPACITY,
+                    indices,
+                    modal,
+                    step,
+                    gaps,
+                    free_steps,
+                );
+                for (gap, &i) in gaps.iter_mut().zip(indices) {
+                    *gap = rest_gaps[i] - *gap;
+                }
             },
         );
         self.stats.record(iterations, converged);
@@ -474,11 +486,6 @@ impl<T: Real> ModalString<T> {
             *value = T::from_f64(*change);
             bridge_change += change;
         }
-        let whole_step = if self.config.track_energy {
-            Some(&mut self.whole_step[..lanes])
-        } else {
-            None
-        };
         let (nut_change, next_norm_squared) = self.kernels.advance_and_prepare(
             &self.a[..lanes],
             &self.b[..lanes],
@@ -487,11 +494,10 @@ impl<T: Real> ModalString<T> {
             MODE_CAPACITY,
             loaded,
             &self.loaded_forces[..loaded.len()],
-            &mut self.modal_force[..lanes],
+            &mut self.whole_step[..lanes],
             &mut self.step[..lanes],
             &mut self.modal[..lanes],
             &mut self.velocity[..lanes],
-            whole_step,
         );
         self.free_step_norm_squared = next_norm_squared;
         if self.config.track_energy {

@@ -11,6 +11,7 @@
 //! rest state its gaps and forces. R enters the static problems only (the rest state, the pressed
 //! finger): the step's coupling is G alone (see `docs/modal-tanpura.md` §8 for why).
 
+use super::lanes::{Kernels, LANE_PADDING};
 use super::modes::{ModeSet, MODE_CAPACITY};
 use crate::tanpura::contact::HuntCrossley;
 use crate::tanpura::geometry::{BridgeSettings, ThreadSettings};
@@ -41,6 +42,12 @@ pub struct ContactPoints {
     /// The rest state: gaps a_rest,i (m) and forces F_rest,i = w_i k ⌊a_rest,i⌋ (N).
     pub rest_gaps_m: Vec<f64>,
     pub rest_forces_n: Vec<f64>,
+    /// Scratch of [`ContactPoints::couple`]: a row of Ψ diag(b), the point indices in order,
+    /// and one row of G and of Ψ Ψᵀ.
+    weighted_row: Vec<f64>,
+    all_points: Vec<usize>,
+    coupling_row: Vec<f64>,
+    kept_row: Vec<f64>,
 }
 
 /// Points of a grid covering `[start, end]` with the given spacing (at least one).
@@ -68,6 +75,10 @@ impl ContactPoints {
             flexible: false,
             rest_gaps_m: zeros(capacity),
             rest_forces_n: zeros(capacity),
+            weighted_row: zeros(MODE_CAPACITY),
+            all_points: (0..capacity).collect(),
+            coupling_row: zeros(capacity),
+            kept_row: zeros(capacity),
         }
     }
 
@@ -181,10 +192,13 @@ impl ContactPoints {
     }
 
     /// Recomputes Ψ, G and (with `flexible`) R for the modes (after [`ContactPoints::place`] or
-    /// a change of the string's parameters). Allocation-free; O(M K + M² K).
-    pub fn couple(&mut self, modes: &ModeSet, flexible: bool) {
+    /// a change of the string's parameters). Allocation-free; O(M K + M² K), the M² K part as
+    /// SIMD dot products (`kernels.dots_pair`): each row i of G and of Ψ Ψᵀ up to the diagonal
+    /// is `Ψ_j · (Ψ_i ⊙ b)` and `Ψ_j · Ψ_i` for j ≤ i. It runs on every retune of a ringing
+    /// string (each tuning pass), so it is on the audio thread's path.
+    pub fn couple(&mut self, modes: &ModeSet, flexible: bool, kernels: &Kernels) {
         self.flexible = flexible;
-        let count = modes.count();
+        let lanes = modes.count().div_ceil(LANE_PADDING) * LANE_PADDING;
         for i in 0..self.count {
             let x = self.positions_m[i];
             modes.shape_row(
@@ -193,15 +207,21 @@ impl ContactPoints {
             );
         }
         for i in 0..self.count {
+            let row_i = &self.shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + lanes];
+            for ((weighted, psi), b) in self.weighted_row.iter_mut().zip(row_i).zip(&modes.b) {
+                *weighted = psi * b;
+            }
+            kernels.dots_pair(
+                &self.shapes,
+                MODE_CAPACITY,
+                &self.all_points[..=i],
+                &self.weighted_row[..lanes],
+                row_i,
+                &mut self.coupling_row[..=i],
+                &mut self.kept_row[..=i],
+            );
             for j in 0..=i {
-                let (row_i, row_j) = (self.shape(i), self.shape(j));
-                // G_ij and the kept modes' static compliance in one pass.
-                let (mut sum, mut kept) = (0.0, 0.0);
-                for k in 0..count {
-                    let product = row_i[k] * row_j[k];
-                    sum += product * modes.b[k];
-                    kept += product;
-                }
+                let (sum, kept) = (self.coupling_row[j], self.kept_row[j]);
                 let residual = if flexible {
                     let (x_i, x_j) = (self.positions_m[i], self.positions_m[j]);
                     modes.static_compliance_m_n(x_i, x_j) - kept
@@ -263,7 +283,7 @@ mod tests {
             -2e-3,
             0.668,
         );
-        points.couple(&modes, true);
+        points.couple(&modes, true, &Kernels::detect());
         assert!(points.len() > 30);
         for i in 0..points.len() {
             assert!(points.coupling(i, i) > 0.0);

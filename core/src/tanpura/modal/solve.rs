@@ -17,6 +17,7 @@
 //! the string in its kept modes), by inverse iteration; the inverse is applied through the
 //! Woodbury identity in O(|A| K).
 
+use super::lanes::{Kernels, LANE_PADDING};
 use super::modes::MODE_CAPACITY;
 use super::points::ContactPoints;
 use crate::dense::DenseCholesky;
@@ -121,6 +122,18 @@ pub struct StaticSolver {
     matrix: Vec<f64>,
     solution: Vec<f64>,
     factor: DenseCholesky,
+    /// The dot products over the modes run as SIMD kernels (`lanes.rs`): every static solve
+    /// and tuning pass of a retune is on the audio thread's path.
+    kernels: Kernels,
+    /// 0, 1, 2, …: the rows of every loaded point, for the kernels.
+    all_rows: Vec<usize>,
+    /// Scratch for one row of dot products.
+    dots: Vec<f64>,
+}
+
+/// The kept modes rounded up to whole registers (the arrays are zero beyond `modes`).
+fn padded(modes: usize) -> usize {
+    modes.div_ceil(LANE_PADDING) * LANE_PADDING
 }
 
 /// Newton updates a static solve may take; each ends the piecewise-linear problem's current
@@ -150,6 +163,9 @@ impl StaticSolver {
             matrix: zeros(capacity * capacity),
             solution: zeros(capacity),
             factor: DenseCholesky::with_capacity(capacity),
+            kernels: Kernels::detect(),
+            all_rows: (0..capacity).collect(),
+            dots: zeros(capacity),
         }
     }
 
@@ -184,13 +200,11 @@ impl StaticSolver {
         self.residual[j * self.capacity + i] = value;
     }
 
-    fn shape(&self, i: usize) -> &[f64] {
-        &self.shapes[i * MODE_CAPACITY..(i + 1) * MODE_CAPACITY]
-    }
-
     /// r = Σ_i forces_i Ψ_i and u = Ψ r + R F for `count` points over `modes` modes; `residual`
     /// is R with row stride `stride`.
+    #[allow(clippy::too_many_arguments)]
     fn modal_response(
+        (kernels, rows): (&Kernels, &[usize]),
         shapes: &[f64],
         (residual, stride): (&[f64], usize),
         count: usize,
@@ -199,7 +213,8 @@ impl StaticSolver {
         modal: &mut [f64],
         displacements: &mut [f64],
     ) {
-        modal[..modes].fill(0.0);
+        let lanes = padded(modes);
+        modal[..lanes].fill(0.0);
         for i in 0..count {
             let force = forces[i];
             if force != 0.0 {
@@ -209,15 +224,20 @@ impl StaticSolver {
                 }
             }
         }
+        kernels.dots(
+            shapes,
+            MODE_CAPACITY,
+            &rows[..count],
+            &modal[..lanes],
+            &mut displacements[..count],
+        );
         for i in 0..count {
-            let row = &shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + modes];
-            let kept: f64 = row.iter().zip(&modal[..modes]).map(|(a, b)| a * b).sum();
             let truncated: f64 = residual[i * stride..i * stride + count]
                 .iter()
                 .zip(&forces[..count])
                 .map(|(r, f)| r * f)
                 .sum();
-            displacements[i] = kept + truncated;
+            displacements[i] += truncated;
         }
     }
 
@@ -257,6 +277,7 @@ impl StaticSolver {
     /// converged. Allocation-free.
     pub fn solve(&mut self, count: usize, modes: usize) -> bool {
         Self::modal_response(
+            (&self.kernels, &self.all_rows),
             &self.shapes,
             (&self.residual, self.capacity),
             count,
@@ -299,15 +320,19 @@ impl StaticSolver {
                 return true;
             }
             // The minimiser of the quadratic model: F_A = D (I + D G_AA D)⁻¹ D g_A.
+            let lanes = padded(modes);
             for row in 0..size {
                 let i = self.active[row];
+                self.kernels.dots(
+                    &self.shapes,
+                    MODE_CAPACITY,
+                    &self.active[..=row],
+                    &self.shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + lanes],
+                    &mut self.dots[..=row],
+                );
                 for column in 0..=row {
                     let j = self.active[column];
-                    let dot: f64 = self.shape(i)[..modes]
-                        .iter()
-                        .zip(&self.shape(j)[..modes])
-                        .map(|(a, b)| a * b)
-                        .sum();
+                    let dot = self.dots[column];
                     let value = self.roots[row] * (dot + self.residual(i, j)) * self.roots[column]
                         + if row == column { 1.0 } else { 0.0 };
                     self.matrix[row * size + column] = value;
@@ -337,6 +362,7 @@ impl StaticSolver {
                         self.forces_n[i] + fraction * (self.trial_forces[i] - self.forces_n[i]);
                 }
                 Self::modal_response(
+                    (&self.kernels, &self.all_rows),
                     &self.shapes,
                     (&self.residual, self.capacity),
                     count,
@@ -381,6 +407,8 @@ pub fn linearised_fundamental(
     solver: &mut StaticSolver,
     iterations: usize,
 ) -> f64 {
+    let lanes = padded(modes);
+    let kernels = solver.kernels;
     // The springs in contact at rest and their Woodbury matrix I + D G^s_AA D.
     let mut size = 0;
     for i in 0..points.len() {
@@ -392,14 +420,15 @@ pub fn linearised_fundamental(
     }
     for row in 0..size {
         let i = solver.active[row];
+        kernels.dots(
+            &points.shapes,
+            MODE_CAPACITY,
+            &solver.active[..=row],
+            &points.shape(i)[..lanes],
+            &mut solver.dots[..=row],
+        );
         for column in 0..=row {
-            let j = solver.active[column];
-            let dot: f64 = points.shape(i)[..modes]
-                .iter()
-                .zip(&points.shape(j)[..modes])
-                .map(|(a, b)| a * b)
-                .sum();
-            let value = solver.roots[row] * dot * solver.roots[column]
+            let value = solver.roots[row] * solver.dots[column] * solver.roots[column]
                 + if row == column { 1.0 } else { 0.0 };
             solver.matrix[row * size + column] = value;
             solver.matrix[column * size + row] = value;
@@ -415,23 +444,27 @@ pub fn linearised_fundamental(
     }
     let x = &mut solver.modal;
     let product = &mut solver.trial_modal;
+    x[modes..lanes].fill(0.0);
+    product[modes..lanes].fill(0.0);
     for k in 0..modes {
         x[k] = 1.0 / omega[k];
     }
     let mut rayleigh = 0.0;
+    let mut norms = [0.0];
     for _ in 0..iterations {
         // v = M x, M = diag(1/ω²); x ← K⁻¹ v = v − Ψ_Aᵀ D (I + D G D)⁻¹ D Ψ_A v.
         for k in 0..modes {
             product[k] = x[k] / (omega[k] * omega[k]);
         }
-        for row in 0..size {
-            let i = solver.active[row];
-            let dot: f64 = points.shape(i)[..modes]
-                .iter()
-                .zip(&product[..modes])
-                .map(|(a, b)| a * b)
-                .sum();
-            solver.solution[row] = solver.roots[row] * dot;
+        kernels.dots(
+            &points.shapes,
+            MODE_CAPACITY,
+            &solver.active[..size],
+            &product[..lanes],
+            &mut solver.solution[..size],
+        );
+        for (value, root) in solver.solution[..size].iter_mut().zip(&solver.roots) {
+            *value *= root;
         }
         if size > 0 {
             solver.factor.solve_in_place(&mut solver.solution[..size]);
@@ -445,21 +478,23 @@ pub fn linearised_fundamental(
             }
         }
         // Rayleigh quotient xᵀ K x / xᵀ M x, K x = x + Ψ_Aᵀ C Ψ_A x.
-        let mut stiffness = x[..modes].iter().map(|v| v * v).sum::<f64>();
-        for row in 0..size {
-            let i = solver.active[row];
-            let dot: f64 = points.shape(i)[..modes]
-                .iter()
-                .zip(&x[..modes])
-                .map(|(a, b)| a * b)
-                .sum();
-            stiffness += solver.roots[row] * solver.roots[row] * dot * dot;
+        kernels.dots(&x[..lanes], lanes, &[0], &x[..lanes], &mut norms);
+        let mut stiffness = norms[0];
+        kernels.dots(
+            &points.shapes,
+            MODE_CAPACITY,
+            &solver.active[..size],
+            &x[..lanes],
+            &mut solver.dots[..size],
+        );
+        for (dot, root) in solver.dots[..size].iter().zip(&solver.roots) {
+            stiffness += root * root * dot * dot;
         }
         let mass: f64 = (0..modes)
             .map(|k| x[k] * x[k] / (omega[k] * omega[k]))
             .sum();
         rayleigh = stiffness / mass;
-        let norm = x[..modes].iter().map(|v| v * v).sum::<f64>().sqrt();
+        let norm = norms[0].sqrt();
         for value in &mut x[..modes] {
             *value /= norm;
         }
