@@ -62,7 +62,15 @@ pub(super) fn ldl_solve_in_place(matrix: &mut [f64], n: usize, x: &mut [f64], sc
 
 /// [`ldl_solve_in_place`] on a fixed-size matrix (lower triangle used), for contact sets of up to
 /// `N` points padded with identity rows; the compiler unrolls it.
+#[cfg(test)]
 pub(super) fn ldl_solve_fixed<const N: usize>(matrix: &mut [[f64; N]; N], x: &mut [f64; N]) {
+    ldl_factor_fixed(matrix);
+    ldl_substitute_fixed(matrix, x);
+}
+
+/// The LDLᵀ factorisation of [`ldl_solve_fixed`], written over `matrix`: `L` below the diagonal,
+/// `D` on it.
+pub(super) fn ldl_factor_fixed<const N: usize>(matrix: &mut [[f64; N]; N]) {
     let mut weighted = [0.0; N];
     for j in 0..N {
         let mut diagonal = matrix[j][j];
@@ -80,17 +88,21 @@ pub(super) fn ldl_solve_fixed<const N: usize>(matrix: &mut [[f64; N]; N], x: &mu
             matrix[i][j] = value * inverse;
         }
     }
+}
+
+/// Solves with the factors of [`ldl_factor_fixed`]: `L y = b`, `D z = y`, `Lᵀ x = z`, in place.
+pub(super) fn ldl_substitute_fixed<const N: usize>(factors: &[[f64; N]; N], x: &mut [f64; N]) {
     for i in 0..N {
         for k in 0..i {
-            x[i] -= matrix[i][k] * x[k];
+            x[i] -= factors[i][k] * x[k];
         }
     }
     for i in 0..N {
-        x[i] /= matrix[i][i];
+        x[i] /= factors[i][i];
     }
     for i in (0..N).rev() {
         for k in 0..i {
-            x[k] -= matrix[i][k] * x[i];
+            x[k] -= factors[i][k] * x[i];
         }
     }
 }

@@ -10,6 +10,11 @@
 //! the accepted Δu satisfies the scheme to the tolerance and the energy balance (eq. M3) holds.
 //! Stops when `max|δ| ≤ tolerance`, or exactly when an update leaves every point in the contact
 //! case it had (the law is linear there); at the cap the last iterate is taken and counted.
+//! When exactly one point enters or leaves contact at the evaluation point (its law is then
+//! `P/s + Q s + K`, every other law linear), the update also solves the step exactly for those
+//! contact cases: a second right-hand side through the same factors and one quadratic
+//! (`ContactStep::finish_exactly`, derived in section 4); if every point then lies in the case it
+//! was evaluated in, the step is exact and the iteration stops.
 //!
 //! **Which points Newton sees.** Only the *tracked* points, those within the tracking band of
 //! contact or loaded at rest, take part; their state lives in compact arrays in slot order, with
@@ -25,7 +30,7 @@
 //! compiler, and nothing here allocates.
 
 use super::points::ContactPoints;
-use super::solve::{ldl_solve_fixed, ldl_solve_in_place};
+use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
 use crate::newton::NewtonSettings;
 use crate::tanpura::contact::HuntCrossley;
 
@@ -78,6 +83,11 @@ pub struct ContactStep {
     matrix: Vec<f64>,
     solution: Vec<f64>,
     scratch: Vec<f64>,
+    /// The exact finish (see [`ContactStep::finish_exactly`]): `D y'` on the active points, the
+    /// direction `w = J⁻¹ G e_c` and the candidate steps.
+    second_solution: Vec<f64>,
+    crossing_direction: Vec<f64>,
+    candidate: Vec<f64>,
     /// The loaded points as point indices and their F − F_rest, N: what the modes feel.
     loaded_points: Vec<usize>,
     loaded_changes_n: Vec<f64>,
@@ -123,6 +133,9 @@ impl ContactStep {
             matrix: vec![0.0; capacity * capacity],
             solution: zeros(),
             scratch: zeros(),
+            second_solution: zeros(),
+            crossing_direction: zeros(),
+            candidate: zeros(),
             loaded_points: vec![0; capacity],
             loaded_changes_n: zeros(),
         }
@@ -437,14 +450,16 @@ impl ContactStep {
         let cap = settings.max_iterations.max(1);
         for iteration in 1..=cap {
             self.evaluate();
-            let linear = self.cases_unchanged();
-            let largest = self.update();
+            let (crossing, crossing_slot) = self.crossing_points();
+            let linear = crossing == 0;
+            let (largest, exact) = self.update((crossing == 1).then_some(crossing_slot));
             if !largest.is_finite() {
                 return (iteration, false);
             }
-            // Linear at the evaluation point and still in the same cases after the update: the
-            // law was linear all the way, so the update solved the step exactly.
-            if largest <= settings.tolerance_m || (linear && self.cases_unchanged()) {
+            // Exact: the update solved the step for the cases of the evaluation point, and the
+            // step lies in those cases (always so when the law was linear at the evaluation point
+            // and the cases did not change).
+            if exact || largest <= settings.tolerance_m || (linear && self.cases_unchanged()) {
                 return (iteration, true);
             }
         }
@@ -462,11 +477,32 @@ impl ContactStep {
             })
     }
 
+    /// How many tracked points enter or leave contact during their step (the law is nonlinear
+    /// only there), and the slot of the last of them.
+    fn crossing_points(&self) -> (usize, usize) {
+        let mut count = 0;
+        let mut last = 0;
+        for (slot, (&gap, &step)) in self.gaps[..self.count]
+            .iter()
+            .zip(&self.steps[..self.count])
+            .enumerate()
+        {
+            let (before, after) = contact_case(gap, step);
+            if before != after {
+                count += 1;
+                last = slot;
+            }
+        }
+        (count, last)
+    }
+
     /// One Newton update `δ = −J⁻¹ R` at the last evaluation; applies it and returns its largest
-    /// component (NaN when the state is not finite). The residual needs G only on the loaded
-    /// points' rows, the linear solve only on the points with `c > 0` (the others' rows of
-    /// `I + D G D` are identity rows).
-    fn update(&mut self) -> f64 {
+    /// component (NaN when the state is not finite) and whether the step is now exact. The
+    /// residual needs G only on the loaded points' rows, the linear solve only on the points with
+    /// `c > 0` (the others' rows of `I + D G D` are identity rows). With `crossing` (the one
+    /// point that enters or leaves contact during its step), the step is first solved exactly
+    /// for the cases of the evaluation point ([`ContactStep::finish_exactly`]).
+    fn update(&mut self, crossing: Option<usize>) -> (f64, bool) {
         let count = self.count;
         let stride = self.capacity;
         // R = Δu − Δu_free − G ΔF, with ΔF ≠ 0 only on the loaded points (G is symmetric, so
@@ -495,10 +531,12 @@ impl ContactStep {
                 size += 1;
             }
         }
+        // The exact finish needs the factors for a second right-hand side: the fixed sizes.
+        let crossing = crossing.filter(|_| size <= 8);
         match size {
             0 => {}
-            1..=4 => self.solve_active_fixed::<4>(size),
-            5..=8 => self.solve_active_fixed::<8>(size),
+            1..=4 => self.solve_active_fixed::<4>(size, crossing),
+            5..=8 => self.solve_active_fixed::<8>(size, crossing),
             _ => self.solve_active_any(size),
         }
         // δ = −R − G_{:,A} D y, a row of the block per active point.
@@ -514,21 +552,118 @@ impl ContactStep {
                 *d -= g * weight;
             }
         }
+        if let Some(crossing) = crossing {
+            if let Some(largest) = self.finish_exactly(crossing, size) {
+                return (largest, true);
+            }
+        }
         let mut largest = 0.0f64;
-        for (step, d) in self.steps[..count].iter_mut().zip(deltas.iter()) {
+        for (step, d) in self.steps[..count]
+            .iter_mut()
+            .zip(self.scratch[..count].iter())
+        {
             *step += d;
             largest = largest.max(d.abs());
         }
         if self.solution[..size].iter().all(|y| y.is_finite()) && largest.is_finite() {
-            largest
+            (largest, false)
         } else {
-            f64::NAN
+            (f64::NAN, false)
         }
     }
 
+    /// The step solved exactly for the contact cases of the evaluation point, when one point `c`
+    /// crosses (enters or leaves contact) and every other point stays in or out, where the law is
+    /// linear in its step (`docs/modal-tanpura.md`, section 4). With the Newton update `δ` (in
+    /// `scratch`) and `w = J⁻¹ G e_c`, the exact step is `Δu + δ + ρ w`, where
+    /// `ρ(s) = F_c(s) − F_c⁰ + c_c (s − s⁰)` is the crossing law's departure from its tangent at the
+    /// evaluation point `s⁰`. On a crossing the law is `F_c(s) = P/s + Q s + K` (leaving:
+    /// `P = ξa²`, `Q = −2ψa`, `K = 0`; entering: `P = −ξa²`, `Q = −ξ`, `K = 2ξa`), so the
+    /// point's own equation `s = s⁰ + δ_c + w_c ρ(s)` is a quadratic in s. Its root in the
+    /// crossing case gives the step; it is taken (and the iterate replaced, returning the largest
+    /// change) only if every point is then in the case it was evaluated in, so that the step
+    /// solves the scheme's equations to round-off. Otherwise `None`, and Newton goes on.
+    /// Newton's own iterates converge to the same root quadratically but from far away, one
+    /// update for every digit pair (3–4 more updates per crossing with stiff contact).
+    fn finish_exactly(&mut self, crossing: usize, size: usize) -> Option<f64> {
+        let count = self.count;
+        let stride = self.capacity;
+        // w = J⁻¹ G e_c = G e_c − G_{:,A} D y', (I + D G_AA D) y' = D G_{A,c}.
+        let direction = &mut self.crossing_direction[..count];
+        direction.copy_from_slice(&self.block[crossing * stride..crossing * stride + count]);
+        for a in 0..size {
+            let row_start = self.active[a] * stride;
+            let row = &self.block[row_start..row_start + count];
+            let weight = self.second_solution[a];
+            for (w, g) in direction.iter_mut().zip(row) {
+                *w -= g * weight;
+            }
+        }
+        let gap = self.gaps[crossing];
+        let start = self.steps[crossing];
+        let law = self.laws[crossing];
+        let leaving = gap > 0.0;
+        let (p, q, k) = if leaving {
+            (law.xi * gap * gap, -2.0 * law.psi * gap, 0.0)
+        } else {
+            (-law.xi * gap * gap, -law.xi, 2.0 * law.xi * gap)
+        };
+        let (force, stiffness) = (self.forces[crossing], self.stiffnesses[crossing]);
+        let w = direction[crossing];
+        let newton = start + self.scratch[crossing];
+        // s − s⁰ − δ_c − w ρ(s) = 0, times s: α s² − β s − γ = 0.
+        let alpha = 1.0 - w * (q + stiffness);
+        let beta = newton + w * (k - force - stiffness * start);
+        let gamma = w * p;
+        let discriminant = beta * beta + 4.0 * alpha * gamma;
+        // Also false for a NaN discriminant.
+        let real_roots = discriminant >= 0.0;
+        if !real_roots || alpha == 0.0 {
+            return None;
+        }
+        let half = 0.5 * (beta + beta.signum() * discriminant.sqrt());
+        if half == 0.0 {
+            return None;
+        }
+        let in_case = |s: f64| {
+            let (before, after) = contact_case(gap, s);
+            before == leaving && after != leaving && s != 0.0
+        };
+        let step = match (half / alpha, -gamma / half) {
+            (one, other) if in_case(one) && in_case(other) => {
+                if (one - newton).abs() <= (other - newton).abs() {
+                    one
+                } else {
+                    other
+                }
+            }
+            (one, _) if in_case(one) => one,
+            (_, other) if in_case(other) => other,
+            _ => return None,
+        };
+        let departure = (p / step + q * step + k) - force + stiffness * (step - start);
+        let mut largest = 0.0f64;
+        for slot in 0..count {
+            let candidate = if slot == crossing {
+                step
+            } else {
+                self.steps[slot] + self.scratch[slot] + departure * self.crossing_direction[slot]
+            };
+            let evaluated = contact_case(self.gaps[slot], self.steps[slot]);
+            if !candidate.is_finite() || contact_case(self.gaps[slot], candidate) != evaluated {
+                return None;
+            }
+            self.candidate[slot] = candidate;
+            largest = largest.max((candidate - self.steps[slot]).abs());
+        }
+        self.steps[..count].copy_from_slice(&self.candidate[..count]);
+        Some(largest)
+    }
+
     /// `(I + D G_AA D) y = −D R_A`, then `y ← D y`, into `solution[..size]`, on `N × N` arrays
-    /// padded with identity rows.
-    fn solve_active_fixed<const N: usize>(&mut self, size: usize) {
+    /// padded with identity rows; with `crossing`, also `(I + D G_AA D) y' = D G_{A,c}` with the
+    /// same factors, `D y'` into `second_solution[..size]`.
+    fn solve_active_fixed<const N: usize>(&mut self, size: usize, crossing: Option<usize>) {
         let stride = self.capacity;
         let mut matrix = [[0.0; N]; N];
         let mut y = [0.0; N];
@@ -542,9 +677,21 @@ impl ContactStep {
             }
             y[a] = -self.roots[a] * self.residual[self.active[a]];
         }
-        ldl_solve_fixed(&mut matrix, &mut y);
+        ldl_factor_fixed(&mut matrix);
+        ldl_substitute_fixed(&matrix, &mut y);
         for a in 0..size {
             self.solution[a] = y[a] * self.roots[a];
+        }
+        if let Some(crossing) = crossing {
+            let column = &self.block[crossing * stride..];
+            let mut second = [0.0; N];
+            for a in 0..size {
+                second[a] = self.roots[a] * column[self.active[a]];
+            }
+            ldl_substitute_fixed(&matrix, &mut second);
+            for a in 0..size {
+                self.second_solution[a] = second[a] * self.roots[a];
+            }
         }
     }
 
