@@ -1160,8 +1160,9 @@ impl Engine {
         }
         // At most one ringing string takes the new settings per control tick, the next in turn
         // whose settings differ: retuning a string (a new rest state and its linearised
-        // fundamental) costs about a fifth of a 64-sample block's deadline at the live tier
-        // (309 µs, studio 739 µs), so retuning every string at every tick of a glide of k_b or
+        // fundamental) costs about a ninth of a 64-sample block's deadline at the live tier
+        // (169 µs, studio 739 µs: `--example retune_cost`), so retuning every string at every
+        // tick of a glide of k_b or
         // the thread missed the deadline several times over (the soak). With eight strings
         // ringing each follows a glide every eight ticks (5.8 ms at 44.1 kHz) and reaches the
         // target at most that late.
