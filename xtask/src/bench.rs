@@ -220,14 +220,17 @@ pub fn percentile(sorted: &[f64], fraction: f64) -> f64 {
     sorted[index.min(sorted.len() - 1)]
 }
 
-fn measure(
-    scene: &mut dyn Scene,
-    seconds: f64,
+/// What a measured run is: its voice, tier and scene, and the fundamental its partials are
+/// measured against.
+#[derive(Debug, Clone, Copy)]
+struct Label {
     voice: &'static str,
     tier: &'static str,
-    scene_name: &'static str,
+    scene: &'static str,
     fundamental_hz: f64,
-) -> BenchResult {
+}
+
+fn measure(scene: &mut dyn Scene, seconds: f64, label: Label) -> BenchResult {
     let samples = (seconds * SAMPLE_RATE) as usize;
     // Written (so its pages are mapped) before the clock starts: the first write to each page of
     // a merely reserved vector faults, and at a few µs per fault on a virtual machine that is a
@@ -252,9 +255,9 @@ fn measure(
     }
     block_times.sort_by(f64::total_cmp);
     BenchResult {
-        voice,
-        tier,
-        scene: scene_name,
+        voice: label.voice,
+        tier: label.tier,
+        scene: label.scene,
         realtime_factor: seconds / rendering_s,
         block_p999: percentile(&block_times, 0.999),
         block_max: *block_times.last().unwrap_or(&0.0),
@@ -263,7 +266,7 @@ fn measure(
         spectral_distance_db: None,
         formant_error: None,
         output,
-        fundamental_hz,
+        fundamental_hz: label.fundamental_hz,
     }
 }
 
@@ -271,27 +274,15 @@ fn measure(
 /// renders are identical (the scenes are deterministic), and another process on the machine can
 /// only add time, so the fastest run is the scene's own cost. Its block statistics are reported
 /// with it.
-#[allow(clippy::too_many_arguments)]
 fn measure_best(
     runs: u32,
     mut build: impl FnMut() -> Box<dyn Scene>,
     seconds: f64,
-    voice: &'static str,
-    tier: &'static str,
-    scene_name: &'static str,
-    fundamental_hz: f64,
+    label: Label,
 ) -> BenchResult {
     let mut best: Option<BenchResult> = None;
     for _ in 0..runs.max(1) {
-        let mut scene = build();
-        let result = measure(
-            scene.as_mut(),
-            seconds,
-            voice,
-            tier,
-            scene_name,
-            fundamental_hz,
-        );
+        let result = measure(build().as_mut(), seconds, label);
         if best
             .as_ref()
             .is_none_or(|fastest| result.realtime_factor > fastest.realtime_factor)
@@ -412,15 +403,13 @@ pub fn run_all(seconds: f64, runs: u32) -> Vec<BenchResult> {
                     }
                 };
                 eprintln!("bench: {scene_name}, {} ...", quality.name());
-                measure_best(
-                    runs,
-                    build,
-                    seconds,
-                    "tanpura",
-                    quality.name(),
-                    scene_name,
-                    sa,
-                )
+                let label = Label {
+                    voice: "tanpura",
+                    tier: quality.name(),
+                    scene: scene_name,
+                    fundamental_hz: sa,
+                };
+                measure_best(runs, build, seconds, label)
             })
             .collect();
         let reference = scene_results[0].clone();
@@ -443,10 +432,12 @@ pub fn run_all(seconds: f64, runs: u32) -> Vec<BenchResult> {
             warmed_bowed_note(voice, seconds)
         },
         seconds,
-        "bowed",
-        "rounded-corner",
-        "bowed-note",
-        BOWED_PITCH_HZ,
+        Label {
+            voice: "bowed",
+            tier: "rounded-corner",
+            scene: "bowed-note",
+            fundamental_hz: BOWED_PITCH_HZ,
+        },
     );
     let mut cheap = measure_best(
         runs,
@@ -455,10 +446,12 @@ pub fn run_all(seconds: f64, runs: u32) -> Vec<BenchResult> {
             warmed_bowed_note(voice, seconds)
         },
         seconds,
-        "bowed",
-        "bow-table",
-        "bowed-note",
-        BOWED_PITCH_HZ,
+        Label {
+            voice: "bowed",
+            tier: "bow-table",
+            scene: "bowed-note",
+            fundamental_hz: BOWED_PITCH_HZ,
+        },
     );
     compare_with_reference(&mut cheap, &reference);
     // The formant trajectory is the tanpura's measure; a bowed note has none.
@@ -483,15 +476,13 @@ pub struct EconomyRow {
 pub fn run_economy(seconds: f64, runs: u32) -> Vec<EconomyRow> {
     let live = settings_at(Quality::Live);
     let row = |build: &dyn Fn() -> Box<dyn Scene>, name: &'static str, note: &'static str| {
-        let result = measure_best(
-            runs,
-            build,
-            seconds,
-            "tanpura",
-            "live",
-            name,
-            live.fundamental_hz,
-        );
+        let label = Label {
+            voice: "tanpura",
+            tier: "live",
+            scene: name,
+            fundamental_hz: live.fundamental_hz,
+        };
+        let result = measure_best(runs, build, seconds, label);
         EconomyRow {
             scene: name,
             realtime_factor: result.realtime_factor,

@@ -29,6 +29,11 @@ use std::fmt::Debug;
 /// (AVX-512), so that every kernel sees whole register pairs on every instruction set.
 pub const LANE_PADDING: usize = 32;
 
+/// `count` modes rounded up to whole [`LANE_PADDING`] blocks: the length every kernel runs over.
+pub fn padded_lanes(count: usize) -> usize {
+    count.div_ceil(LANE_PADDING) * LANE_PADDING
+}
+
 /// A floating-point type the mode kernels run in.
 pub trait Real: Copy + Default + Debug + PartialEq + Send + Sync + 'static {
     /// The SIMD register of this type for the instruction set `S`.

@@ -38,7 +38,7 @@ use crate::newton::{NewtonSettings, NewtonStats};
 use crate::tanpura::excitation::{finger_height_m, Pluck};
 use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
 use crate::tanpura::string::StringParameters;
-use lanes::{Kernels, Real, LANE_PADDING};
+use lanes::{padded_lanes, Kernels, Real, LANE_PADDING};
 use modes::{ModeSet, AUDIBLE_LIMIT_HZ, MODE_CAPACITY};
 use points::{grid_points, ContactPoints};
 use solve::{linearised_fundamental, StaticSolver};
@@ -197,9 +197,9 @@ pub struct ModalString<T: Real> {
     step: Vec<T>,
     /// ‖s_free‖₂², for the far points' bounds.
     free_step_norm_squared: f64,
-    /// The whole step of the last step (written by every step; the loss ledger reads it).
+    /// The whole step of the last step (written by every step; the loss ledger reads it right
+    /// after). Between steps it is free: `set_config` keeps the physical velocity in it.
     whole_step: Vec<T>,
-    modal_force: Vec<T>,
     /// Ψ rows in T, `points.capacity() × MODE_CAPACITY` (the force projection).
     shapes: Vec<T>,
     /// ‖Ψ_i‖₂ over the kept modes, with a margin for the rounding of the T rows: the bound
@@ -242,7 +242,6 @@ impl<T: Real> ModalString<T> {
             step: vec![T::default(); MODE_CAPACITY],
             free_step_norm_squared: 0.0,
             whole_step: vec![T::default(); MODE_CAPACITY],
-            modal_force: vec![T::default(); MODE_CAPACITY],
             shapes: vec![T::default(); points * MODE_CAPACITY],
             shape_norms: vec![0.0; points],
             points: ContactPoints::with_capacity(points),
@@ -290,7 +289,7 @@ impl<T: Real> ModalString<T> {
                 0.0
             };
             self.row[k] = (self.modal[k].to_f64() + self.rest_modal[k]) * scale;
-            self.modal_force[k] = T::from_f64(self.velocity[k].to_f64() * scale);
+            self.whole_step[k] = T::from_f64(self.velocity[k].to_f64() * scale);
         }
         self.config = config;
         self.apply_config();
@@ -303,7 +302,7 @@ impl<T: Real> ModalString<T> {
                 0.0
             };
             self.modal[k] = T::from_f64(self.row[k] * root - self.rest_modal[k]);
-            self.velocity[k] = T::from_f64(self.modal_force[k].to_f64() * root);
+            self.velocity[k] = T::from_f64(self.whole_step[k].to_f64() * root);
         }
         self.refresh_gaps();
         true
@@ -326,7 +325,7 @@ impl<T: Real> ModalString<T> {
         );
         self.points
             .couple(&self.modes, config.static_flexibility, &self.kernels);
-        self.lanes = self.modes.count().div_ceil(LANE_PADDING) * LANE_PADDING;
+        self.lanes = padded_lanes(self.modes.count());
         for k in 0..MODE_CAPACITY {
             self.a[k] = T::from_f64(self.modes.a[k]);
             self.b[k] = T::from_f64(self.modes.b[k]);

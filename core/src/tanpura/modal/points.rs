@@ -11,7 +11,7 @@
 //! rest state its gaps and forces. R enters the static problems only (the rest state, the pressed
 //! finger): the step's coupling is G alone (see `docs/modal-tanpura.md` §8 for why).
 
-use super::lanes::{Kernels, LANE_PADDING};
+use super::lanes::{padded_lanes, Kernels};
 use super::modes::{ModeSet, MODE_CAPACITY};
 use crate::tanpura::contact::HuntCrossley;
 use crate::tanpura::geometry::{BridgeSettings, ThreadSettings};
@@ -198,7 +198,7 @@ impl ContactPoints {
     /// string (each tuning pass), so it is on the audio thread's path.
     pub fn couple(&mut self, modes: &ModeSet, flexible: bool, kernels: &Kernels) {
         self.flexible = flexible;
-        let lanes = modes.count().div_ceil(LANE_PADDING) * LANE_PADDING;
+        let lanes = padded_lanes(modes.count());
         for i in 0..self.count {
             let x = self.positions_m[i];
             modes.shape_row(

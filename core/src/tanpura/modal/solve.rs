@@ -17,7 +17,7 @@
 //! the string in its kept modes), by inverse iteration; the inverse is applied through the
 //! Woodbury identity in O(|A| K).
 
-use super::lanes::{Kernels, LANE_PADDING};
+use super::lanes::{padded_lanes, Kernels};
 use super::modes::MODE_CAPACITY;
 use super::points::ContactPoints;
 use crate::dense::DenseCholesky;
@@ -143,11 +143,6 @@ pub struct StaticSolver {
     dots: Vec<f64>,
 }
 
-/// The kept modes rounded up to whole registers (the arrays are zero beyond `modes`).
-fn padded(modes: usize) -> usize {
-    modes.div_ceil(LANE_PADDING) * LANE_PADDING
-}
-
 /// Newton updates a static solve may take; each ends the piecewise-linear problem's current
 /// contact set, so a handful suffice (the line search makes up to this many safe).
 const STATIC_MAX_ITERATIONS: usize = 100;
@@ -225,7 +220,7 @@ impl StaticSolver {
         modal: &mut [f64],
         displacements: &mut [f64],
     ) {
-        let lanes = padded(modes);
+        let lanes = padded_lanes(modes);
         modal[..lanes].fill(0.0);
         for i in 0..count {
             let force = forces[i];
@@ -332,7 +327,7 @@ impl StaticSolver {
                 return true;
             }
             // The minimiser of the quadratic model: F_A = D (I + D G_AA D)⁻¹ D g_A.
-            let lanes = padded(modes);
+            let lanes = padded_lanes(modes);
             for row in 0..size {
                 let i = self.active[row];
                 self.kernels.dots(
@@ -419,7 +414,7 @@ pub fn linearised_fundamental(
     solver: &mut StaticSolver,
     iterations: usize,
 ) -> f64 {
-    let lanes = padded(modes);
+    let lanes = padded_lanes(modes);
     let kernels = solver.kernels;
     // The springs in contact at rest and their Woodbury matrix I + D G^s_AA D.
     let mut size = 0;
