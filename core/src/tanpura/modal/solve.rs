@@ -60,8 +60,8 @@ pub(super) fn ldl_solve_in_place(matrix: &mut [f64], n: usize, x: &mut [f64], sc
     }
 }
 
-/// [`ldl_solve_in_place`] on a fixed-size matrix (lower triangle used), for contact sets of up to
-/// `N` points padded with identity rows; the compiler unrolls it.
+/// [`ldl_solve_in_place`] on a fixed-size matrix (lower triangle used), for a contact set of
+/// exactly `N` points; the compiler unrolls it.
 #[cfg(test)]
 pub(super) fn ldl_solve_fixed<const N: usize>(matrix: &mut [[f64; N]; N], x: &mut [f64; N]) {
     ldl_factor_fixed(matrix);

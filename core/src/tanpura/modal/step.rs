@@ -535,8 +535,14 @@ impl ContactStep {
         let crossing = crossing.filter(|_| size <= 8);
         match size {
             0 => {}
-            1..=4 => self.solve_active_fixed::<4>(size, crossing),
-            5..=8 => self.solve_active_fixed::<8>(size, crossing),
+            1 => self.solve_active_fixed::<1>(crossing),
+            2 => self.solve_active_fixed::<2>(crossing),
+            3 => self.solve_active_fixed::<3>(crossing),
+            4 => self.solve_active_fixed::<4>(crossing),
+            5 => self.solve_active_fixed::<5>(crossing),
+            6 => self.solve_active_fixed::<6>(crossing),
+            7 => self.solve_active_fixed::<7>(crossing),
+            8 => self.solve_active_fixed::<8>(crossing),
             _ => self.solve_active_any(size),
         }
         // δ = −R − G_{:,A} D y, a row of the block per active point.
@@ -660,36 +666,34 @@ impl ContactStep {
         Some(largest)
     }
 
-    /// `(I + D G_AA D) y = −D R_A`, then `y ← D y`, into `solution[..size]`, on `N × N` arrays
-    /// padded with identity rows; with `crossing`, also `(I + D G_AA D) y' = D G_{A,c}` with the
-    /// same factors, `D y'` into `second_solution[..size]`.
-    fn solve_active_fixed<const N: usize>(&mut self, size: usize, crossing: Option<usize>) {
+    /// `(I + D G_AA D) y = −D R_A`, then `y ← D y`, into `solution[..N]`, for exactly `N` active
+    /// points (the loops unroll and the arrays stay in registers); with `crossing`, also
+    /// `(I + D G_AA D) y' = D G_{A,c}` with the same factors, `D y'` into `second_solution[..N]`.
+    fn solve_active_fixed<const N: usize>(&mut self, crossing: Option<usize>) {
         let stride = self.capacity;
         let mut matrix = [[0.0; N]; N];
         let mut y = [0.0; N];
-        for (a, row) in matrix.iter_mut().enumerate() {
-            row[a] = 1.0;
-        }
-        for a in 0..size {
+        for a in 0..N {
             let row = &self.block[self.active[a] * stride..];
             for b in 0..=a {
-                matrix[a][b] += self.roots[a] * row[self.active[b]] * self.roots[b];
+                matrix[a][b] = self.roots[a] * row[self.active[b]] * self.roots[b];
             }
+            matrix[a][a] += 1.0;
             y[a] = -self.roots[a] * self.residual[self.active[a]];
         }
         ldl_factor_fixed(&mut matrix);
         ldl_substitute_fixed(&matrix, &mut y);
-        for a in 0..size {
+        for a in 0..N {
             self.solution[a] = y[a] * self.roots[a];
         }
         if let Some(crossing) = crossing {
             let column = &self.block[crossing * stride..];
             let mut second = [0.0; N];
-            for a in 0..size {
+            for a in 0..N {
                 second[a] = self.roots[a] * column[self.active[a]];
             }
             ldl_substitute_fixed(&matrix, &mut second);
-            for a in 0..size {
+            for a in 0..N {
                 self.second_solution[a] = second[a] * self.roots[a];
             }
         }
