@@ -1,9 +1,9 @@
 //! The loops over the modes, as SIMD kernels dispatched at run time.
 //!
 //! The modal step (`docs/modal-tanpura.md`, eq. M1) spends its time in two passes over the
-//! contiguous mode arrays: the free motion of the contact points near contact `Δu_i = Ψ_i · s`
-//! (one dot product per point), and the update that adds the contact forces, advances the state,
-//! forms the nut force and computes the next step's free step `s = a p − b r` and its norm in the
+//! contiguous mode arrays: the free motion of every contact point `Δu_i = Ψ_i · s` (one dot
+//! product per point), and the update that adds the contact forces, advances the state,
+//! forms the nut force and computes the next step's free step `s = a p − b r` in the
 //! same pass, so that a step stores only r, p and s. (The free step alone, [`Kernels::free_step`],
 //! is needed only after the state is set from outside.) Each pass is a [`pulp::WithSimd`] kernel:
 //! [`pulp::Arch`] picks AVX-512, AVX2+FMA or scalar code once per process from the CPU, so the one
@@ -318,7 +318,7 @@ const REGISTER_ROWS: usize = 8;
 
 /// Adds the contact forces to the free step, advances the state (eq. M1) and prepares the next
 /// step, in one pass over the modes: `s += b Σ_j ΔF_j Ψ_j`, `r += s`, `p = s − p`, then the next
-/// free step `s ← a p − b r`. Returns the nut force `c · r` after the step and `‖s_next‖²`. The
+/// free step `s ← a p − b r`. Returns the nut force `c · r` after the step. The
 /// modal force of the first [`REGISTER_ROWS`] rows never leaves the registers, so a pass stores
 /// only r, p, the next free step and the whole step.
 struct AdvanceAndPrepare<'a, T: Real> {
@@ -341,9 +341,9 @@ impl<T: Real> AdvanceAndPrepare<'_, T> {
     /// The pass with `ROWS` rows in registers (and, if `SPILLS`, the rest summed into `work`
     /// first). The row count is a constant so that the force sum unrolls and every slice has the
     /// registers' count as its length: no bounds check and no loop counter inside the pass. The
-    /// nut force and the norm keep one accumulator for the even registers and one for the odd.
+    /// nut force keeps one accumulator for the even registers and one for the odd.
     #[inline(always)]
-    fn run<S: Simd, const ROWS: usize, const SPILLS: bool>(self, simd: S) -> (f64, f64) {
+    fn run<S: Simd, const ROWS: usize, const SPILLS: bool>(self, simd: S) -> f64 {
         let zero = T::splat(simd, T::default());
         let length = self.s.len();
         let s = T::lanes_mut::<S>(self.s);
@@ -376,7 +376,7 @@ impl<T: Real> AdvanceAndPrepare<'_, T> {
         // One register of modes, written out twice below (a closure would not inherit the
         // kernel's target features and would not be inlined).
         macro_rules! advance {
-            ($v:expr, $nut:ident, $norm:ident) => {{
+            ($v:expr, $nut:ident) => {{
                 let v = $v;
                 let mut force = if SPILLS { work[v] } else { zero };
                 for j in 0..ROWS {
@@ -395,26 +395,22 @@ impl<T: Real> AdvanceAndPrepare<'_, T> {
                     T::mul(simd, b[v], displacement),
                 );
                 s[v] = next;
-                $norm = T::mul_add(simd, next, next, $norm);
             }};
         }
-        let (mut nut_even, mut nut_odd, mut norm_even, mut norm_odd) = (zero, zero, zero, zero);
+        let (mut nut_even, mut nut_odd) = (zero, zero);
         for pair in 0..registers / 2 {
-            advance!(2 * pair, nut_even, norm_even);
-            advance!(2 * pair + 1, nut_odd, norm_odd);
+            advance!(2 * pair, nut_even);
+            advance!(2 * pair + 1, nut_odd);
         }
-        (
-            T::sum(simd, T::add(simd, nut_even, nut_odd)).to_f64(),
-            T::sum(simd, T::add(simd, norm_even, norm_odd)).to_f64(),
-        )
+        T::sum(simd, T::add(simd, nut_even, nut_odd)).to_f64()
     }
 }
 
 impl<T: Real> WithSimd for AdvanceAndPrepare<'_, T> {
-    type Output = (f64, f64);
+    type Output = f64;
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> (f64, f64) {
+    fn with_simd<S: Simd>(self, simd: S) -> f64 {
         match self.rows.len() {
             0 => self.run::<S, 0, false>(simd),
             1 => self.run::<S, 1, false>(simd),
@@ -483,7 +479,7 @@ impl Kernels {
     }
 
     /// `s += b Σ_j forces_j matrix[rows_j]`, `r += s`, `p = s − p`, then the next free step
-    /// `s ← a p − b r`; returns `(c · r, ‖s‖²)` after the step. `work` (the arrays' length) holds
+    /// `s ← a p − b r`; returns `c · r` after the step. `work` (the arrays' length) holds
     /// the whole step `s + b Σ_j forces_j matrix[rows_j]` on return.
     #[allow(clippy::too_many_arguments)]
     pub fn advance_and_prepare<T: Real>(
@@ -499,7 +495,7 @@ impl Kernels {
         s: &mut [T],
         r: &mut [T],
         p: &mut [T],
-    ) -> (f64, f64) {
+    ) -> f64 {
         debug_assert!(forces.len() >= rows.len());
         self.arch.dispatch(AdvanceAndPrepare {
             a,
@@ -564,7 +560,7 @@ mod tests {
             let forces: Vec<f64> = (0..count).map(|j| 0.3 - 0.17 * j as f64).collect();
             let (mut s2, mut r2, mut p2) = (s.clone(), r.clone(), p.clone());
             let mut whole = vec![0.0; n];
-            let (nut, norm) = kernels.advance_and_prepare(
+            let nut = kernels.advance_and_prepare(
                 &a,
                 &b,
                 &c,
@@ -577,7 +573,7 @@ mod tests {
                 &mut r2,
                 &mut p2,
             );
-            let (mut plain_nut, mut plain_norm) = (0.0, 0.0);
+            let mut plain_nut = 0.0;
             for k in 0..n {
                 let modal: f64 = (0..count).map(|j| forces[j] * rows[j][k]).sum();
                 let step = s[k] + b[k] * modal;
@@ -588,10 +584,8 @@ mod tests {
                 assert!((p2[k] - velocity).abs() < 1e-13);
                 assert!((s2[k] - next).abs() < 1e-13);
                 plain_nut += c[k] * displacement;
-                plain_norm += next * next;
             }
             assert!((nut - plain_nut).abs() < 1e-12, "{count} rows");
-            assert!((norm - plain_norm).abs() < 1e-12, "{count} rows");
         }
     }
 

@@ -18,12 +18,12 @@
 //!
 //! **Which points Newton sees.** Only the *tracked* points, those within the tracking band of
 //! contact or loaded at rest, take part; their state lives in compact arrays in slot order, with
-//! their block of G, so a step touches no index list and no other point. Every other (far) point
-//! carries an upper bound on its gap, raised each step by the most it can move,
-//! `‖Ψ_i‖ ‖s_free‖ + |Σ_j G_ij ΔF_j|` (Cauchy–Schwarz); one pass over all points, in plain
-//! arrays the compiler vectorises, forms these bounds, and only a point whose bound reaches
-//! contact is evaluated exactly. If it would touch during the step it joins and the solve is
-//! redone before anything moves, so the solve is exact for every point.
+//! their block of G, so Newton touches no index list and no other point. Every point's free step
+//! `Ψ_i s_free` is computed each step (one dot product per point, in the mode kernels), so every
+//! other (far) point's step is known exactly once the forces are, `Ψ_i s_free + Σ_j G_ij ΔF_j`,
+//! and its gap follows it. One pass over all points, in plain arrays the compiler vectorises,
+//! checks whether a far point would touch; if one would, it joins and the solve is redone before
+//! anything moves, so the solve is exact for every point.
 //!
 //! Hand-written rather than on a linear-algebra crate: the systems are 1–12 points, solved once
 //! or twice per sample on the audio thread; the fixed-size LDLᵀ of `solve.rs` is unrolled by the
@@ -41,19 +41,16 @@ const UNTRACKED: usize = usize::MAX;
 #[derive(Debug, Clone)]
 pub struct ContactStep {
     capacity: usize,
-    /// a_i per point, m: exact for the tracked points (after every step), the last exact value
-    /// for the far ones.
+    /// a_i per point, m, after every step.
     pub gaps_m: Vec<f64>,
-    /// An upper bound on a_i for a far point, m; −∞ for a tracked point, so that no test on far
-    /// points ever selects it.
-    far_bounds_m: Vec<f64>,
-    /// This step's `Σ_j G_ij ΔF_j` and raised bound, per point.
+    /// 0 for a far point, −∞ for a tracked one: added to a gap, it keeps every test on far
+    /// points from selecting a tracked point, in loops without branches.
+    far_offsets_m: Vec<f64>,
+    /// Every point's index, the rows of the free-step kernel, and `Ψ_i s_free` per point, m.
+    all_points: Vec<usize>,
+    point_free_steps_m: Vec<f64>,
+    /// This step's `Σ_j G_ij ΔF_j` per point, m.
     coupled_m: Vec<f64>,
-    next_bounds_m: Vec<f64>,
-    /// Far points to evaluate exactly, and their exact gaps and free steps.
-    candidates: Vec<usize>,
-    candidate_gaps_m: Vec<f64>,
-    candidate_free_steps_m: Vec<f64>,
     /// Each point's slot among the tracked, or [`UNTRACKED`].
     slots: Vec<usize>,
     /// The tracked points (point indices), in slot order.
@@ -106,12 +103,10 @@ impl ContactStep {
         Self {
             capacity,
             gaps_m: zeros(),
-            far_bounds_m: zeros(),
+            far_offsets_m: zeros(),
+            all_points: (0..capacity).collect(),
+            point_free_steps_m: zeros(),
             coupled_m: zeros(),
-            next_bounds_m: zeros(),
-            candidates: vec![0; capacity],
-            candidate_gaps_m: zeros(),
-            candidate_free_steps_m: zeros(),
             slots: vec![UNTRACKED; capacity],
             tracked: vec![0; capacity],
             count: 0,
@@ -141,11 +136,12 @@ impl ContactStep {
         }
     }
 
-    /// The tracked points in slot order, and where their free steps `Ψ_i s_free` go.
-    pub fn tracked_rows(&mut self) -> (&[usize], &mut [f64]) {
+    /// The first `count` points' indices, and where their free steps `Ψ_i s_free` go (every
+    /// step, before [`ContactStep::solve`]).
+    pub fn point_rows(&mut self, count: usize) -> (&[usize], &mut [f64]) {
         (
-            &self.tracked[..self.count],
-            &mut self.free_steps[..self.count],
+            &self.all_points[..count],
+            &mut self.point_free_steps_m[..count],
         )
     }
 
@@ -169,7 +165,7 @@ impl ContactStep {
         }
         self.count = 0;
         for i in 0..points.len() {
-            self.far_bounds_m[i] = self.gaps_m[i];
+            self.far_offsets_m[i] = 0.0;
             if self.gaps_m[i] > -band_m || points.rest_forces_n[i] != 0.0 {
                 self.track(points, i, self.gaps_m[i], 0.0, 0.0);
             }
@@ -196,7 +192,7 @@ impl ContactStep {
         self.count += 1;
         self.slots[i] = slot;
         self.tracked[slot] = i;
-        self.far_bounds_m[i] = f64::NEG_INFINITY;
+        self.far_offsets_m[i] = f64::NEG_INFINITY;
         self.gaps[slot] = gap;
         self.free_steps[slot] = free_step;
         self.steps[slot] = free_step + correction;
@@ -216,7 +212,7 @@ impl ContactStep {
     fn untrack(&mut self, slot: usize) {
         let i = self.tracked[slot];
         self.slots[i] = UNTRACKED;
-        self.far_bounds_m[i] = self.gaps[slot];
+        self.far_offsets_m[i] = 0.0;
         self.corrections[slot] = 0.0;
         let last = self.count - 1;
         self.count = last;
@@ -242,21 +238,14 @@ impl ContactStep {
         self.block[slot * stride + slot] = self.block[last * stride + last];
     }
 
-    /// Solves the step's contact (the free steps of the tracked points must be in place). Far
-    /// points whose bounds reach contact are evaluated together by
-    /// `refresh(points, gaps, free_steps)`, which writes each listed point's `a_i` and
-    /// `Ψ_i s_free`; one that would touch joins and the solve is redone. Returns (Newton
-    /// updates, converged).
-    pub fn solve(
-        &mut self,
-        points: &ContactPoints,
-        shape_norms: &[f64],
-        step_norm: f64,
-        settings: &NewtonSettings,
-        mut refresh: impl FnMut(&[usize], &mut [f64], &mut [f64]),
-    ) -> (u32, bool) {
+    /// Solves the step's contact (every point's free step must be in place, from
+    /// [`ContactStep::point_rows`]). A far point that would touch during the step joins and the
+    /// solve is redone. Returns (Newton updates, converged).
+    pub fn solve(&mut self, points: &ContactPoints, settings: &NewtonSettings) -> (u32, bool) {
         for slot in 0..self.count {
-            self.steps[slot] = self.free_steps[slot] + self.corrections[slot];
+            let free_step = self.point_free_steps_m[self.tracked[slot]];
+            self.free_steps[slot] = free_step;
+            self.steps[slot] = free_step + self.corrections[slot];
         }
         let mut iterations = 0;
         let mut converged = true;
@@ -268,7 +257,7 @@ impl ContactStep {
                 // The forces at the accepted step, for the update, the outputs and the ledger.
                 self.evaluate();
             }
-            if !self.check_far_points(points, shape_norms, step_norm, &mut refresh) {
+            if !self.join_touching(points) {
                 break;
             }
         }
@@ -279,16 +268,10 @@ impl ContactStep {
         (iterations, converged)
     }
 
-    /// Raises every far point's gap bound by the most it can move this step; a point whose bound
-    /// reaches contact is evaluated exactly, and one that would touch joins (returns true: the
-    /// solve must be redone).
-    fn check_far_points(
-        &mut self,
-        points: &ContactPoints,
-        shape_norms: &[f64],
-        step_norm: f64,
-        refresh: &mut impl FnMut(&[usize], &mut [f64], &mut [f64]),
-    ) -> bool {
+    /// Forms every point's `Σ_j G_ij ΔF_j` at the current forces; a far point whose step
+    /// `Ψ_i s_free + Σ_j G_ij ΔF_j` would bring it into contact joins (returns true: the solve
+    /// must be redone).
+    fn join_touching(&mut self, points: &ContactPoints) -> bool {
         let count = points.len();
         let stride = self.capacity;
         // Σ_j G_ij ΔF_j for every point, a row of G (= its column) per loaded point.
@@ -301,48 +284,34 @@ impl ContactStep {
                 *sum += g * change;
             }
         }
-        let mut reaches_contact = false;
-        let bounds = self.far_bounds_m[..count]
+        let mut touches = false;
+        let far_gaps = self.gaps_m[..count]
             .iter()
-            .zip(&shape_norms[..count])
-            .zip(coupled.iter());
-        for (next, ((&bound, &norm), &coupled)) in
-            self.next_bounds_m[..count].iter_mut().zip(bounds)
-        {
-            *next = bound + (norm * step_norm + coupled.abs());
-            reaches_contact |= *next > 0.0;
+            .zip(&self.far_offsets_m[..count]);
+        for ((&gap, &offset), (&free_step, &coupled)) in far_gaps.zip(
+            self.point_free_steps_m[..count]
+                .iter()
+                .zip(&self.coupled_m[..count]),
+        ) {
+            touches |= (gap + offset) - (free_step + coupled) > 0.0;
         }
-        if !reaches_contact {
+        if !touches {
             return false;
         }
-        // Branch-free selection: every point is written, the count advances on the selected.
-        let mut listed = 0;
-        for (i, &bound) in self.next_bounds_m[..count].iter().enumerate() {
-            self.candidates[listed] = i;
-            listed += usize::from(bound > 0.0);
-        }
-        refresh(
-            &self.candidates[..listed],
-            &mut self.candidate_gaps_m[..listed],
-            &mut self.candidate_free_steps_m[..listed],
-        );
-        let mut joined = false;
-        for candidate in 0..listed {
-            let i = self.candidates[candidate];
-            let gap = self.candidate_gaps_m[candidate];
-            let free_step = self.candidate_free_steps_m[candidate];
-            let coupled = self.coupled_m[i];
-            let step = free_step + coupled;
-            self.gaps_m[i] = gap;
-            if gap - step > 0.0 {
-                self.track(points, i, gap, free_step, coupled);
-                joined = true;
-            } else {
-                self.far_bounds_m[i] = gap;
-                self.next_bounds_m[i] = gap - step;
+        for i in 0..count {
+            let step = self.point_free_steps_m[i] + self.coupled_m[i];
+            let gap = self.gaps_m[i];
+            if self.slots[i] == UNTRACKED && gap - step > 0.0 {
+                self.track(
+                    points,
+                    i,
+                    gap,
+                    self.point_free_steps_m[i],
+                    self.coupled_m[i],
+                );
             }
         }
-        joined
+        true
     }
 
     /// After the solve: moves the tracked gaps by the accepted steps, keeps the corrections for
@@ -350,7 +319,14 @@ impl ContactStep {
     /// the tracked points after the step (0 if none), m.
     pub fn finish_step(&mut self, points: &ContactPoints) -> f64 {
         let count = points.len();
-        self.far_bounds_m[..count].copy_from_slice(&self.next_bounds_m[..count]);
+        // Every point by its step at the converged forces; the tracked ones by Newton's below.
+        for ((gap, &free_step), &coupled) in self.gaps_m[..count]
+            .iter_mut()
+            .zip(&self.point_free_steps_m[..count])
+            .zip(&self.coupled_m[..count])
+        {
+            *gap -= free_step + coupled;
+        }
         let mut penetration = 0.0f64;
         for slot in 0..self.count {
             let gap = self.gaps[slot] - self.steps[slot];
@@ -363,15 +339,8 @@ impl ContactStep {
     }
 
     /// After a step: tracked points farther than `release_m` from contact with no force now and
-    /// none at rest leave; far points whose bound comes within `band_m` of contact get their
-    /// exact gaps, all at once from `exact_gaps(points, gaps)`, and join if within the band.
-    pub fn update_tracking(
-        &mut self,
-        points: &ContactPoints,
-        band_m: f64,
-        release_m: f64,
-        mut exact_gaps: impl FnMut(&[usize], &mut [f64]),
-    ) {
+    /// none at rest leave; far points within `band_m` of contact join.
+    pub fn update_tracking(&mut self, points: &ContactPoints, band_m: f64, release_m: f64) {
         let mut slot = 0;
         while slot < self.count {
             let far = self.gaps[slot] < -release_m
@@ -383,25 +352,20 @@ impl ContactStep {
                 slot += 1;
             }
         }
-        // Branch-free selection, as in `check_far_points`; tracked points have a bound of −∞.
-        let mut listed = 0;
-        for (i, &bound) in self.far_bounds_m[..points.len()].iter().enumerate() {
-            self.candidates[listed] = i;
-            listed += usize::from(bound > -band_m);
+        let count = points.len();
+        let mut near = false;
+        for (&gap, &offset) in self.gaps_m[..count]
+            .iter()
+            .zip(&self.far_offsets_m[..count])
+        {
+            near |= gap + offset > -band_m;
         }
-        if listed == 0 {
+        if !near {
             return;
         }
-        exact_gaps(
-            &self.candidates[..listed],
-            &mut self.candidate_gaps_m[..listed],
-        );
-        for candidate in 0..listed {
-            let i = self.candidates[candidate];
-            let gap = self.candidate_gaps_m[candidate];
-            self.gaps_m[i] = gap;
-            self.far_bounds_m[i] = gap;
-            if gap > -band_m {
+        for i in 0..count {
+            let gap = self.gaps_m[i];
+            if self.slots[i] == UNTRACKED && gap > -band_m {
                 self.track(points, i, gap, 0.0, 0.0);
             }
         }
