@@ -96,7 +96,7 @@ pub const MODAL_VIEW_INTERVALS: usize = 200;
 const _: () = assert!(MODAL_VIEW_INTERVALS < MAX_STRING_NODES);
 
 /// A modal string's contact points `range` as a barrier view, with the string's displacement
-/// there from its modes (the far points' gaps are only bounded between exact evaluations).
+/// there from its modes.
 fn fill_points<const CAPACITY: usize>(
     view: &mut BarrierView<CAPACITY>,
     string: &ModalString<f32>,
