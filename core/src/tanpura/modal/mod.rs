@@ -378,16 +378,22 @@ impl<T: Real> ModalString<T> {
     /// step.
     fn refresh_gaps(&mut self) {
         self.prepare_free_step();
-        let modes = self.modes.count();
         for i in 0..self.points.len() {
-            let displacement: f64 = self.points.shape(i)[..modes]
-                .iter()
-                .zip(&self.modal[..modes])
-                .map(|(psi, r)| psi * r.to_f64())
-                .sum();
-            self.contact.gaps_m[i] = self.points.rest_gaps_m[i] - displacement;
+            self.contact.gaps_m[i] = self.modal_gap_m(i);
         }
         self.contact.classify(&self.points, TRACKING_BAND_M);
+    }
+
+    /// Point i's gap from the modal state, `a_rest,i − Ψ_i r̃`, in f64 (a step carries the
+    /// gaps forward instead).
+    fn modal_gap_m(&self, i: usize) -> f64 {
+        let modes = self.modes.count();
+        let displacement: f64 = self.points.shape(i)[..modes]
+            .iter()
+            .zip(&self.modal[..modes])
+            .map(|(psi, r)| psi * r.to_f64())
+            .sum();
+        self.points.rest_gaps_m[i] - displacement
     }
 
     /// Puts a decayed string exactly at rest (the sleeping state), keeping the ledgers.
@@ -816,15 +822,9 @@ mod tests {
         for step in 1..=steps {
             string.step();
             if step % 4_410 == 0 {
-                let modes = string.modes.count();
                 for i in 0..string.points.len() {
-                    let displacement: f64 = string.points.shape(i)[..modes]
-                        .iter()
-                        .zip(&string.modal[..modes])
-                        .map(|(psi, r)| psi * r.to_f64())
-                        .sum();
-                    let exact = string.points.rest_gaps_m[i] - displacement;
-                    worst = worst.max((string.contact.gaps_m[i] - exact).abs());
+                    let error = string.contact.gaps_m[i] - string.modal_gap_m(i);
+                    worst = worst.max(error.abs());
                 }
             }
         }
