@@ -56,8 +56,8 @@ const GROUPS: usize = MAX_BODY_RESONANCES.div_ceil(LANES);
 /// zero coefficients and zero state, so they output exactly 0.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct SectionGroup {
+    /// b0 (b2 = −b0, b1 = 0 for a band-pass), a1 and a2.
     b0: [f64; LANES],
-    b2: [f64; LANES],
     a1: [f64; LANES],
     a2: [f64; LANES],
     s1: [f64; LANES],
@@ -65,15 +65,16 @@ pub(crate) struct SectionGroup {
 }
 
 impl SectionGroup {
-    /// One sample through the four sections: transposed direct form II, b1 = 0 for a
-    /// band-pass.
+    /// One sample through the four sections: transposed direct form II, b1 = 0 and b2 = −b0
+    /// for a band-pass, so `b2 x = −(b0 x)` exactly and the product is formed once.
     #[inline]
     fn tick(&mut self, x: f64) -> [f64; LANES] {
         let mut y = [0.0; LANES];
         for lane in 0..LANES {
-            y[lane] = self.b0[lane] * x + self.s1[lane];
-            self.s1[lane] = -self.a1[lane] * y[lane] + self.s2[lane];
-            self.s2[lane] = self.b2[lane] * x - self.a2[lane] * y[lane];
+            let input = self.b0[lane] * x;
+            y[lane] = input + self.s1[lane];
+            self.s1[lane] = self.s2[lane] - self.a1[lane] * y[lane];
+            self.s2[lane] = -input - self.a2[lane] * y[lane];
         }
         y
     }
@@ -134,7 +135,6 @@ impl BodyFilter {
             let lane = index % LANES;
             if index >= self.count {
                 group.b0[lane] = 0.0;
-                group.b2[lane] = 0.0;
                 group.a1[lane] = 0.0;
                 group.a2[lane] = 0.0;
                 group.s1[lane] = 0.0;
@@ -149,7 +149,6 @@ impl BodyFilter {
             let alpha = omega.sin() / (2.0 * resonance.quality.max(1e-3));
             let a0 = 1.0 + alpha;
             group.b0[lane] = resonance.gain_per_n * alpha / a0;
-            group.b2[lane] = -group.b0[lane];
             group.a1[lane] = -2.0 * omega.cos() / a0;
             group.a2[lane] = (1.0 - alpha) / a0;
         }
@@ -221,6 +220,18 @@ impl<'a, const G: usize> BodyRun<'a, G> {
             }
         }
         sum
+    }
+
+    /// [`Self::tick`] for each force of a run, into `out`. Never inlined, so that it is compiled
+    /// for the baseline unit even when its caller is compiled for AVX2 (`bow_table.rs`): inlined
+    /// into the AVX2 block path the body cost 25 µs per 0.1 s of the bench's bowed note, against
+    /// 11 µs on 128-bit registers (divan, `scene::process`; the 2-core AMD EPYC splits 256-bit
+    /// operations in two, and the sum across the lanes pays for the extractions).
+    #[inline(never)]
+    pub(crate) fn filter_run(&mut self, forces: &[f64], out: &mut [f64]) {
+        for (filtered, &force) in out.iter_mut().zip(forces) {
+            *filtered = self.tick(force);
+        }
     }
 
     /// As [`BodyFilter::reset`].
