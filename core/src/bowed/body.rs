@@ -71,6 +71,21 @@ fn lane_sum(y: [f64; LANES]) -> f64 {
     (y[0] + y[2]) + (y[1] + y[3])
 }
 
+/// One sample of `x` through `groups`, their outputs summed in group order (0 without groups):
+/// the one summation of the sample and block paths.
+#[inline(always)]
+fn group_sum(groups: &mut [SectionGroup], x: f64) -> f64 {
+    let mut groups = groups.iter_mut();
+    let Some(first) = groups.next() else {
+        return 0.0;
+    };
+    let mut sum = lane_sum(first.tick(x));
+    for group in groups {
+        sum += lane_sum(group.tick(x));
+    }
+    sum
+}
+
 impl SectionGroup {
     /// One sample through the four sections: transposed direct form II, b1 = 0 and b2 = −b0
     /// for a band-pass, so `b2 x = −(b0 x)` exactly and the product is formed once.
@@ -164,12 +179,8 @@ impl BodyFilter {
     /// Filter one sample of bridge force (N).
     #[inline]
     pub fn tick(&mut self, bridge_force_n: f64) -> f64 {
-        let mut sum = 0.0;
-        for group in &mut self.groups[..self.active_groups] {
-            // The idle lanes add exact zeros.
-            sum += lane_sum(group.tick(bridge_force_n));
-        }
-        sum
+        // The idle lanes add exact zeros.
+        group_sum(&mut self.groups[..self.active_groups], bridge_force_n)
     }
 
     /// Zero the filter states.
@@ -218,11 +229,7 @@ impl<'a, const G: usize> BodyRun<'a, G> {
     /// As [`BodyFilter::tick`] (the same arithmetic in the same order).
     #[inline]
     pub(crate) fn tick(&mut self, bridge_force_n: f64) -> f64 {
-        let mut sum = 0.0;
-        for group in self.groups.iter_mut() {
-            sum += lane_sum(group.tick(bridge_force_n));
-        }
-        sum
+        group_sum(self.groups, bridge_force_n)
     }
 
     /// [`Self::tick`] for each force of a run, into `out`. Never inlined, so that it is compiled
