@@ -60,8 +60,11 @@ pub(crate) struct SectionGroup {
     b0: [f64; LANES],
     a1: [f64; LANES],
     a2: [f64; LANES],
-    s1: [f64; LANES],
-    s2: [f64; LANES],
+    /// The last output y_n, and the second state of transposed form II one and two samples
+    /// back, `s_n = b2 x_n − a2 y_n` and `s_{n−1}`.
+    y1: [f64; LANES],
+    s_last: [f64; LANES],
+    s_before: [f64; LANES],
 }
 
 /// The sum of a group's four outputs as two pairs, `(y₀ + y₂) + (y₁ + y₃)`: one vector addition
@@ -87,23 +90,29 @@ fn group_sum(groups: &mut [SectionGroup], x: f64) -> f64 {
 }
 
 impl SectionGroup {
-    /// One sample through the four sections: transposed direct form II, b1 = 0 and b2 = −b0
-    /// for a band-pass, so `b2 x = −(b0 x)` exactly and the product is formed once.
+    /// One sample through the four sections: transposed direct form II with b1 = 0 and
+    /// b2 = −b0 (a band-pass), its first state substituted, so that
+    /// `y_{n+1} = (b0 x_{n+1} + s_{n−1}) − a1 y_n` and `s_{n+1} = −b0 x_{n+1} − a2 y_{n+1}`. The
+    /// recursion from one output to the next is then one multiplication and one subtraction
+    /// (the form with s1 chained a multiplication and two additions), and `b2 x = −(b0 x)` is
+    /// formed once.
     #[inline]
     fn tick(&mut self, x: f64) -> [f64; LANES] {
         let mut y = [0.0; LANES];
         for lane in 0..LANES {
             let input = self.b0[lane] * x;
-            y[lane] = input + self.s1[lane];
-            self.s1[lane] = self.s2[lane] - self.a1[lane] * y[lane];
-            self.s2[lane] = -input - self.a2[lane] * y[lane];
+            y[lane] = (input + self.s_before[lane]) - self.a1[lane] * self.y1[lane];
+            self.s_before[lane] = self.s_last[lane];
+            self.s_last[lane] = -input - self.a2[lane] * y[lane];
         }
+        self.y1 = y;
         y
     }
 
     fn reset(&mut self) {
-        self.s1 = [0.0; LANES];
-        self.s2 = [0.0; LANES];
+        self.y1 = [0.0; LANES];
+        self.s_last = [0.0; LANES];
+        self.s_before = [0.0; LANES];
     }
 }
 
@@ -159,8 +168,9 @@ impl BodyFilter {
                 group.b0[lane] = 0.0;
                 group.a1[lane] = 0.0;
                 group.a2[lane] = 0.0;
-                group.s1[lane] = 0.0;
-                group.s2[lane] = 0.0;
+                group.y1[lane] = 0.0;
+                group.s_last[lane] = 0.0;
+                group.s_before[lane] = 0.0;
                 continue;
             }
             let resonance = &self.resonances[index];
