@@ -42,7 +42,8 @@
 //! at run time through pulp (`RenderOnUnit`): the same operations, so the same bits, on
 //! three-operand AVX2 instructions where the machine has them (body off 24.8 → 20 µs per 0.1 s,
 //! divan). The body filter's stage stays on the baseline unit (`BodyRun::filter_run`, never
-//! inlined), where its four sections ran faster than in 256-bit code; body on 35.9 → 33 µs.
+//! inlined), where its four sections ran faster than in 256-bit code; with the body's shorter
+//! recursion (`body.rs`), body on 35.9 → 29.2 µs (docs/performance.md).
 
 use super::body::{BodyFilter, BodyResonance, BodyRun, VIOLIN_BODY};
 use super::bowed_string::{all_finite, StringConstants, BOW_POSITION_RANGE};
@@ -365,9 +366,9 @@ impl BowTableString {
 }
 
 /// [`BowTableString::process`] with `G` body groups, compiled for each vector unit and picked at
-/// run time: on AVX2 the body's four sections take one 256-bit register instead of two 128-bit
-/// ones. The same operations in the same order (no fused multiply-add), so every unit computes
-/// the same bits as `next_sample`.
+/// run time: on AVX2 the reads, junctions and pushes run on three-operand instructions (the body
+/// filter's stage stays on the baseline unit, `BodyRun::filter_run`). The same operations in the
+/// same order (no fused multiply-add), so every unit computes the same bits as `next_sample`.
 struct RenderOnUnit<'a, const G: usize> {
     voice: &'a mut BowTableString,
     radiated: &'a mut [f32],

@@ -298,6 +298,9 @@ impl ContactStep {
         if !touches {
             return false;
         }
+        // The same test point by point; the solve is redone only if a point did join, so the
+        // loop in `solve` ends whatever the values.
+        let mut joined = false;
         for i in 0..count {
             let step = self.point_free_steps_m[i] + self.coupled_m[i];
             let gap = self.gaps_m[i];
@@ -309,9 +312,10 @@ impl ContactStep {
                     self.point_free_steps_m[i],
                     self.coupled_m[i],
                 );
+                joined = true;
             }
         }
-        true
+        joined
     }
 
     /// After the solve: moves the tracked gaps by the accepted steps, keeps the corrections for
