@@ -1162,10 +1162,9 @@ impl Engine {
         // whose settings differ: retuning a string (a new rest state and its linearised
         // fundamental) costs about a ninth of a 64-sample block's deadline at the live tier
         // (169 µs, studio 739 µs: `--example retune_cost`), so retuning every string at every
-        // tick of a glide of k_b or
-        // the thread missed the deadline several times over (the soak). With eight strings
-        // ringing each follows a glide every eight ticks (5.8 ms at 44.1 kHz) and reaches the
-        // target at most that late.
+        // tick of a glide of k_b or the thread missed the deadline several times over (the
+        // soak). With eight strings ringing each follows a glide every eight ticks (5.8 ms at
+        // 44.1 kHz) and reaches the target at most that late.
         let count = self.slots.len();
         for step in 0..count {
             let index = (self.retune_cursor + step) % count;
