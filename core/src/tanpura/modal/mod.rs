@@ -35,6 +35,7 @@ pub mod solve;
 pub mod step;
 
 use crate::newton::{NewtonSettings, NewtonStats};
+use crate::simd::CacheAligned;
 use crate::tanpura::excitation::{finger_height_m, Pluck};
 use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
 use crate::tanpura::string::StringParameters;
@@ -183,21 +184,21 @@ pub struct ModalString<T: Real> {
     /// The kept modes rounded up to whole registers: the length the kernels run over.
     lanes: usize,
     // The mode arrays the kernels run on (T), MODE_CAPACITY long, zero beyond the kept modes.
-    a: Vec<T>,
-    b: Vec<T>,
-    nut_weights: Vec<T>,
+    a: CacheAligned<T>,
+    b: CacheAligned<T>,
+    nut_weights: CacheAligned<T>,
     /// r̃ = r − r_rest.
-    modal: Vec<T>,
+    modal: CacheAligned<T>,
     /// p, the scaled velocity of eq. M1.
-    velocity: Vec<T>,
+    velocity: CacheAligned<T>,
     /// s_free, the free step from the current state (kept by every step and every change of
     /// the state from outside, [`ModalString::prepare_free_step`]).
-    step: Vec<T>,
+    step: CacheAligned<T>,
     /// The whole step of the last step (written by every step; the loss ledger reads it right
     /// after). Between steps it is free: `set_config` keeps the physical velocity in it.
-    whole_step: Vec<T>,
+    whole_step: CacheAligned<T>,
     /// Ψ rows in T, `points.capacity() × MODE_CAPACITY` (the force projection).
-    shapes: Vec<T>,
+    shapes: CacheAligned<T>,
     points: ContactPoints,
     contact: ContactStep,
     solver: StaticSolver,
@@ -227,14 +228,14 @@ impl<T: Real> ModalString<T> {
             modes: ModeSet::new(),
             kernels: Kernels::detect(),
             lanes: 0,
-            a: vec![T::default(); MODE_CAPACITY],
-            b: vec![T::default(); MODE_CAPACITY],
-            nut_weights: vec![T::default(); MODE_CAPACITY],
-            modal: vec![T::default(); MODE_CAPACITY],
-            velocity: vec![T::default(); MODE_CAPACITY],
-            step: vec![T::default(); MODE_CAPACITY],
-            whole_step: vec![T::default(); MODE_CAPACITY],
-            shapes: vec![T::default(); points * MODE_CAPACITY],
+            a: CacheAligned::new(MODE_CAPACITY, T::default()),
+            b: CacheAligned::new(MODE_CAPACITY, T::default()),
+            nut_weights: CacheAligned::new(MODE_CAPACITY, T::default()),
+            modal: CacheAligned::new(MODE_CAPACITY, T::default()),
+            velocity: CacheAligned::new(MODE_CAPACITY, T::default()),
+            step: CacheAligned::new(MODE_CAPACITY, T::default()),
+            whole_step: CacheAligned::new(MODE_CAPACITY, T::default()),
+            shapes: CacheAligned::new(points * MODE_CAPACITY, T::default()),
             points: ContactPoints::with_capacity(points),
             contact: ContactStep::new(points),
             solver: StaticSolver::new(points + finger),

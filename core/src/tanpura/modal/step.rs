@@ -275,13 +275,24 @@ impl ContactStep {
         let count = points.len();
         let stride = self.capacity;
         // Σ_j G_ij ΔF_j for every point, a row of G (= its column) per loaded point.
+        // The first loaded point's row is written, not added to zeros: a fill of a few hundred
+        // bytes is a call into libc's memset every step (2.4 % of the live step's time, perf).
         let coupled = &mut self.coupled_m[..count];
-        coupled.fill(0.0);
-        for &local in &self.loaded[..self.loaded_count] {
-            let row = self.tracked[local] * stride;
-            let change = self.changes[local];
-            for (sum, g) in coupled.iter_mut().zip(&points.coupling[row..row + count]) {
-                *sum += g * change;
+        match self.loaded[..self.loaded_count].split_first() {
+            None => coupled.fill(0.0),
+            Some((&first, rest)) => {
+                let row = self.tracked[first] * stride;
+                let change = self.changes[first];
+                for (sum, g) in coupled.iter_mut().zip(&points.coupling[row..row + count]) {
+                    *sum = g * change;
+                }
+                for &local in rest {
+                    let row = self.tracked[local] * stride;
+                    let change = self.changes[local];
+                    for (sum, g) in coupled.iter_mut().zip(&points.coupling[row..row + count]) {
+                        *sum += g * change;
+                    }
+                }
             }
         }
         let mut touches = false;
