@@ -733,11 +733,22 @@ impl<T: Real> ModalString<T> {
         (&self.modal[..count], &self.velocity[..count])
     }
 
-    /// The gaps a_i of the points, m (positive: the string penetrates): exact for the points near
-    /// contact, the last computed value for the far ones (whose gaps are only bounded while they
-    /// cannot touch; [`ModalString::displacement_at_m`] gives the exact shape anywhere).
+    /// The gaps a_i of the points after the last step, m (positive: the string penetrates),
+    /// each carried by its step (`a_rest,i − Ψ_i r̃` to within a few nanometres of round-off,
+    /// tested); [`ModalString::displacement_at_m`] gives the shape anywhere.
     pub fn gaps_m(&self) -> &[f64] {
         &self.contact.gaps_m[..self.points.len()]
+    }
+
+    /// The points' positions, m: the bridge's first ([`ModalString::bridge_point_count`]), then
+    /// the thread's.
+    pub fn point_positions_m(&self) -> &[f64] {
+        &self.points.positions_m[..self.points.len()]
+    }
+
+    /// How many of the points lie on the bridge (the rest lie on the thread).
+    pub fn bridge_point_count(&self) -> usize {
+        self.points.bridge_count()
     }
 
     /// The fundamental of small vibrations about the rest state with every point in contact at

@@ -1,0 +1,210 @@
+//! Why the live tier is brighter than the reference late in a note: the bridge crest's contact in
+//! the two schemes. `cargo run --release --example crest_contact` (about twenty seconds).
+//!
+//! 1. The seed's string at rest and plucked as in the bench (its physical parameters as they are,
+//!    no tuning per scheme), 3 s, on the FD scheme at the seed's grid and on the modal scheme at
+//!    the live tier's point spacing: the deepest bridge gap at rest (positive: the string lies on
+//!    the bridge), then per half second the string's landings on the bridge per second (a step
+//!    with some bridge point in contact after one with none: an impact, which radiates a broad
+//!    band) and the share of steps with some bridge point in contact.
+//! 2. The bench's one-string scene at the live and reference tiers (each tuned as the plugin
+//!    tunes it): the spectrum's median and loudest bin between 4 and 16 kHz at five times after
+//!    the pluck (8192-sample Hann frames, dB of the output's power), and the live tier's
+//!    third-octave levels above 1 kHz against the reference's, as the bench's spectral distance
+//!    measures them.
+//!
+//! Printed, not asserted: the figures are quoted in `docs/modal-tanpura.md`, section 8.
+
+use javari_core::analysis::power_spectrum;
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::fd::{FdString, FdStringConfig};
+use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
+use javari_core::tanpura::quality::Quality;
+use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
+
+const SECONDS: f64 = 3.0;
+const WINDOW_S: f64 = 0.5;
+
+/// Counts, per window, the string's landings on the bridge (a step with some bridge point in
+/// contact after a step with none: an impact) and the steps with some point in contact.
+#[derive(Default)]
+struct Census {
+    was_in_contact: bool,
+    landings: usize,
+    steps_in_contact: usize,
+}
+
+impl Census {
+    fn record(&mut self, mut gaps_m: impl Iterator<Item = f64>) {
+        let in_contact = gaps_m.any(|gap| gap > 0.0);
+        self.landings += usize::from(in_contact && !self.was_in_contact);
+        self.steps_in_contact += usize::from(in_contact);
+        self.was_in_contact = in_contact;
+    }
+
+    /// "landings per second, share of steps in contact" for a window of `steps` steps, and resets.
+    fn report(&mut self, steps: usize) -> String {
+        let line = format!(
+            "{:5.0} /s, {:5.1} %",
+            self.landings as f64 / WINDOW_S,
+            100.0 * self.steps_in_contact as f64 / steps as f64
+        );
+        self.landings = 0;
+        self.steps_in_contact = 0;
+        line
+    }
+}
+
+fn contact_census() {
+    let mut fd = FdString::new(FdStringConfig::REFERENCE);
+    let grid = fd.bridge_grid().clone();
+    let fd_gaps = |string: &FdString| -> Vec<f64> {
+        (0..grid.len())
+            .map(|i| grid.heights_m()[i] - grid.interpolate(string.displacement_m(), i))
+            .collect()
+    };
+    let mut modal = ModalString::<f32>::new(ModalStringConfig::REFERENCE);
+    let bridge = modal.bridge_point_count();
+    let deepest = |gaps: &[f64]| gaps.iter().cloned().fold(f64::MIN, f64::max) * 1e6;
+    println!("The seed's string, plucked as in the bench: contact on the bridge");
+    println!(
+        "at rest, deepest bridge gap (positive: on the crest): FD {:+.1} µm, modal {:+.1} µm",
+        deepest(&fd_gaps(&fd)),
+        deepest(&modal.gaps_m()[..bridge])
+    );
+    fd.pluck(&Pluck::default());
+    modal.pluck(&Pluck::default());
+    let fd_window = (WINDOW_S / fd.config().time_step_s).round() as usize;
+    let modal_window = (WINDOW_S / modal.config().time_step_s).round() as usize;
+    let (mut fd_census, mut modal_census) = (Census::default(), Census::default());
+    println!("| window | FD (seed grid, 176.4 kHz) | modal (live spacing, 44.1 kHz) |");
+    println!("|---|---|---|");
+    let windows = (SECONDS / WINDOW_S).round() as usize;
+    for window in 0..windows {
+        for _ in 0..fd_window {
+            fd.step();
+            fd_census.record(fd_gaps(&fd).into_iter());
+        }
+        for _ in 0..modal_window {
+            modal.step();
+            modal_census.record(modal.gaps_m()[..bridge].iter().copied());
+        }
+        println!(
+            "| {:.1}–{:.1} s | {} | {} |",
+            window as f64 * WINDOW_S,
+            (window + 1) as f64 * WINDOW_S,
+            fd_census.report(fd_window),
+            modal_census.report(modal_window)
+        );
+    }
+}
+
+fn one_string(quality: Quality) -> Vec<f64> {
+    let settings = VoiceSettings {
+        quality,
+        ..VoiceSettings::default()
+    };
+    let mut voice = TanpuraVoice::new(&settings, 44_100.0);
+    voice.pluck(&Pluck::default());
+    let mut output = vec![0.0f32; (SECONDS * 44_100.0) as usize / 64 * 64];
+    for block in output.chunks_mut(64) {
+        voice.process(block);
+    }
+    output.iter().map(|&x| f64::from(x)).collect()
+}
+
+fn high_band() {
+    const FRAME: usize = 8192;
+    let bin_hz = 44_100.0 / FRAME as f64;
+    let renders = [one_string(Quality::Reference), one_string(Quality::Live)];
+    println!();
+    println!("The bench's one-string scene: 4–16 kHz, median / loudest bin (dB)");
+    println!("| frame from | reference | live |");
+    println!("|---|---|---|");
+    for start_s in [0.3, 1.0, 1.5, 2.0, 2.5] {
+        let start = (start_s * 44_100.0) as usize;
+        let cells: Vec<String> = renders
+            .iter()
+            .map(|output| {
+                let spectrum = power_spectrum(output, start, FRAME, FRAME);
+                let band = &spectrum[(4_000.0 / bin_hz) as usize..(16_000.0 / bin_hz) as usize];
+                let mut levels: Vec<f64> = band
+                    .iter()
+                    .map(|power| 10.0 * (power + 1e-30).log10())
+                    .collect();
+                levels.sort_by(f64::total_cmp);
+                format!(
+                    "{:.1} / {:.1}",
+                    levels[levels.len() / 2],
+                    levels[levels.len() - 1]
+                )
+            })
+            .collect();
+        println!("| {start_s:.1} s | {} | {} |", cells[0], cells[1]);
+    }
+}
+
+/// Third-octave band levels (dB) of 4096-sample frames, 40 Hz to 16 kHz, as the bench measures
+/// its spectral distance; returns the bands' lower edges and the levels per frame.
+fn band_levels(output: &[f64]) -> (Vec<f64>, Vec<Vec<f64>>) {
+    const FRAME: usize = 4096;
+    let bin_hz = 44_100.0 / FRAME as f64;
+    let mut edges = vec![40.0f64];
+    while *edges.last().unwrap_or(&16_000.0) < 16_000.0 {
+        let next = edges[edges.len() - 1] * 2f64.powf(1.0 / 3.0);
+        edges.push(next);
+    }
+    let levels = (0..output.len() / FRAME)
+        .map(|frame| {
+            let spectrum = power_spectrum(output, frame * FRAME, FRAME, FRAME);
+            edges
+                .windows(2)
+                .map(|band| {
+                    let power: f64 = spectrum
+                        .iter()
+                        .enumerate()
+                        .filter(|(k, _)| (band[0]..=band[1]).contains(&(*k as f64 * bin_hz)))
+                        .map(|(_, p)| p)
+                        .sum();
+                    10.0 * (power + 1e-30).log10()
+                })
+                .collect()
+        })
+        .collect();
+    (edges, levels)
+}
+
+/// The live tier's third-octave levels above 1 kHz against the reference's, averaged over the
+/// frames where the reference's band lies within 60 dB of its loudest (the bench's rule).
+fn band_differences() {
+    let (edges, reference) = band_levels(&one_string(Quality::Reference));
+    let (_, live) = band_levels(&one_string(Quality::Live));
+    println!();
+    println!(
+        "The bench's one-string scene: live minus reference, third-octave bands, mean over 3 s"
+    );
+    println!("| band from | difference | frames counted |");
+    println!("|---|---|---|");
+    for (band, low) in edges.iter().enumerate().take(edges.len() - 1) {
+        if *low < 1_000.0 {
+            continue;
+        }
+        let (mut sum, mut count) = (0.0, 0);
+        for (mine, theirs) in live.iter().zip(&reference) {
+            let floor = theirs.iter().cloned().fold(f64::MIN, f64::max) - 60.0;
+            if theirs[band] > floor {
+                sum += mine[band].max(floor) - theirs[band];
+                count += 1;
+            }
+        }
+        if count > 0 {
+            println!("| {low:.0} Hz | {:+.1} dB | {count} |", sum / count as f64);
+        }
+    }
+}
+
+fn main() {
+    contact_census();
+    high_band();
+    band_differences();
+}
