@@ -18,13 +18,15 @@ fn plucked<T: javari_core::tanpura::modal::lanes::Real>(
 }
 
 /// With and without the truncated modes' static flexibility (which moves the rest state, not
-/// the scheme), the lossless H is conserved.
+/// the scheme), and with residual modes (more modes of the same recursion), the lossless H is
+/// conserved.
 #[test]
 fn lossless_energy_is_conserved_to_1e_10_in_contact() {
-    for flexible in [true, false] {
+    for (flexible, residual_modes) in [(true, 0), (false, 0), (false, 2)] {
         let mut config = ModalStringConfig::REFERENCE.lossless();
         config.track_energy = true;
         config.static_flexibility = flexible;
+        config.residual_modes = residual_modes;
         let mut string = plucked::<f64>(config);
         let initial = string.energy_j();
         let mut worst = 0.0f64;
@@ -40,7 +42,7 @@ fn lossless_energy_is_conserved_to_1e_10_in_contact() {
         assert_eq!(string.cumulative_losses_j(), 0.0);
         assert!(
             worst <= 1e-10,
-            "relative energy drift {worst:e} (flexible: {flexible})"
+            "relative energy drift {worst:e} (flexible: {flexible}, residual modes: {residual_modes})"
         );
     }
 }
@@ -62,6 +64,65 @@ fn lossy_run(config: ModalStringConfig, seconds: f64) -> (ModalString<f64>, f64,
         previous = energy;
     }
     (string, worst_increase, worst_balance)
+}
+
+/// Residual modes (two, as the example `crest_contact` runs them): the lossy balance holds, and
+/// the string rests on the bridge crest and settles onto it as the continuous string does, where
+/// the kept modes alone leave it above the crest, striking it to the end of the note.
+#[test]
+fn residual_modes_keep_the_balance_and_let_the_string_settle_on_the_crest() {
+    let mut config = ModalStringConfig::REFERENCE;
+    config.track_energy = true;
+    config.residual_modes = 2;
+    let (_, worst_increase, worst_balance) = lossy_run(config, 0.5);
+    assert!(
+        worst_increase <= 1e-14,
+        "H increased by {worst_increase:e} of H(0)"
+    );
+    assert!(worst_balance <= 1e-10, "balance error {worst_balance:e}");
+
+    // Landings on the bridge (a step with a bridge point in contact after one with none) in
+    // 2.0–2.5 s after the pluck, and the deepest bridge gap at rest.
+    let settle = |residual_modes: usize| {
+        let mut string = ModalString::<f32>::new(ModalStringConfig {
+            residual_modes,
+            ..ModalStringConfig::REFERENCE
+        });
+        let bridge = string.bridge_point_count();
+        let deepest_at_rest = string.gaps_m()[..bridge]
+            .iter()
+            .cloned()
+            .fold(f64::MIN, f64::max);
+        string.pluck(&Pluck::default());
+        let (mut landings, mut was_in_contact) = (0, false);
+        for step in 0..(2.5 * SAMPLE_RATE) as usize {
+            string.step();
+            let in_contact = string.gaps_m()[..bridge].iter().any(|&gap| gap > 0.0);
+            if step as f64 >= 2.0 * SAMPLE_RATE && in_contact && !was_in_contact {
+                landings += 1;
+            }
+            was_in_contact = in_contact;
+        }
+        (deepest_at_rest, landings)
+    };
+    let (kept_rest, kept_landings) = settle(0);
+    let (residual_rest, residual_landings) = settle(2);
+    assert!(
+        kept_rest < -5e-6,
+        "kept modes alone: {kept_rest:e} m at rest"
+    );
+    assert!(
+        kept_landings > 500,
+        "kept modes alone: {kept_landings} landings"
+    );
+    assert!(
+        residual_rest > 0.0,
+        "residual modes: {residual_rest:e} m at rest"
+    );
+    assert_eq!(
+        residual_landings, 0,
+        "residual modes: the string still strikes the crest"
+    );
 }
 
 #[test]

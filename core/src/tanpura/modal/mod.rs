@@ -7,7 +7,9 @@
 //! - `modes.rs`: the string's eigenmodes with the lowered support (section 1), each advanced by an
 //!   exact two-pole recursion in mid-point form at the output rate (eq. M1–M2): exact partial
 //!   frequencies and decay rates σ = γ/2 + ηω²/2 at any sample rate, no oversampling, no
-//!   dispersion, no decimator. Modes below min(20 kHz, 0.45 f_s) are kept.
+//!   dispersion, no decimator. Modes below min(20 kHz, 0.45 f_s) are kept. Optionally
+//!   ([`ModalStringConfig::residual_modes`], section 8) a few residual modes follow them: the
+//!   truncated modes' static compliance on the contact points, as resonators at 0.475 f_s.
 //! - `points.rs`: the bridge and thread as a few contact points, coupled to the modes through the
 //!   mode shapes there, with the seed's mid-point Hunt–Crossley force (eq. 4, `contact.rs`).
 //! - `solve.rs`: Newton's method on the points that touch (section 4), the static problems of
@@ -50,6 +52,9 @@ const _: () = assert!(MODE_CAPACITY.is_multiple_of(LANE_PADDING));
 
 /// Largest fingertip the finger's points have room for, m.
 const MAX_FINGER_WIDTH_M: f64 = 0.040;
+/// The residual modes ring at this fraction of the sample rate: above the kept modes (at most
+/// 0.45 of it) and below Nyquist.
+const RESIDUAL_MODE_RATE_FRACTION: f64 = 0.475;
 /// Inverse iterations for the linearised fundamental (the error falls by (f₁/f₂)² ≈ 1/4 each).
 const TUNING_ITERATIONS: usize = 30;
 /// Points whose gap lies within this distance of contact are tracked: Newton iterates on them.
@@ -84,6 +89,10 @@ pub struct ModalStringConfig {
     /// residual displacement stays frozen at its rest value while the string moves, which
     /// distorts the contact near the crest (the formant stops falling between 0.5 and 1.5 s).
     pub static_flexibility: bool,
+    /// Residual modes (section 8): resonators above the kept modes that carry the truncated
+    /// modes' static compliance on the contact points, so that the string rests where the
+    /// continuous string rests and energy taken into the truncated modes comes back. 0: none.
+    pub residual_modes: usize,
 }
 
 impl ModalStringConfig {
@@ -104,6 +113,7 @@ impl ModalStringConfig {
         },
         track_energy: false,
         static_flexibility: false,
+        residual_modes: 0,
     };
 
     /// The same with all losses off (γ = η = r_b = r_c = 0).
@@ -304,6 +314,12 @@ impl<T: Real> ModalString<T> {
         let config = self.config;
         self.modes
             .configure(&config.string, config.time_step_s, config.highest_mode_hz);
+        self.modes.set_residual_modes(
+            config.residual_modes,
+            2.0 * PI * RESIDUAL_MODE_RATE_FRACTION / config.time_step_s,
+            &config.string,
+            config.time_step_s,
+        );
         self.points.place(
             &config.bridge,
             config.bridge_start_m(),

@@ -28,7 +28,11 @@ pub const NYQUIST_GUARD: f64 = 0.45;
 /// Everything about the modes that depends on the string and the time step, in f64.
 #[derive(Debug, Clone)]
 pub struct ModeSet {
+    /// Every mode the step advances: the kept string modes, then the residual modes.
     count: usize,
+    /// The kept string modes (sines); `kept..count` are residual modes (see
+    /// [`ModeSet::set_residual_modes`]).
+    kept: usize,
     length_m: f64,
     /// T, N, and EI, N m²: the static compliance of all the modes is closed-form in them.
     tension_n: f64,
@@ -58,6 +62,7 @@ impl ModeSet {
         let zeros = || vec![0.0; MODE_CAPACITY];
         Self {
             count: 0,
+            kept: 0,
             length_m: 1.0,
             tension_n: 1.0,
             bending_stiffness_n_m2: 0.0,
@@ -73,9 +78,47 @@ impl ModeSet {
         }
     }
 
-    /// K, the modes kept.
+    /// Every mode the step advances (the kept modes and the residual modes).
     pub fn count(&self) -> usize {
         self.count
+    }
+
+    /// K, the string's modes kept (sines).
+    pub fn kept(&self) -> usize {
+        self.kept
+    }
+
+    /// Appends `count` residual modes after the kept ones (dropping any earlier ones), each a
+    /// resonator of angular frequency `angular_frequency` with the string's loss law at that
+    /// frequency (`σ = γ/2 + ηω²/2`), advanced by the same exact recursion. They have no shape
+    /// along the string: their shapes at the contact points are set by
+    /// [`super::points::ContactPoints::couple`], and their stiffness, shape factor and nut weight
+    /// are zero, so that every sum along the string skips them. Allocation-free.
+    pub fn set_residual_modes(
+        &mut self,
+        count: usize,
+        angular_frequency: f64,
+        string: &StringParameters,
+        time_step_s: f64,
+    ) {
+        let count = count.min(MODE_CAPACITY - self.kept);
+        let decay =
+            0.5 * string.gamma_per_s + 0.5 * string.eta_s * angular_frequency * angular_frequency;
+        let (a, b, det) = recursion_coefficients(angular_frequency, decay, time_step_s);
+        for index in self.kept..MODE_CAPACITY {
+            let residual = index < self.kept + count;
+            let value = |v: f64| if residual { v } else { 0.0 };
+            self.stiffness[index] = 0.0;
+            self.inverse_root_stiffness[index] = 0.0;
+            self.angular_frequency[index] = value(angular_frequency);
+            self.decay[index] = value(decay);
+            self.a[index] = value(a);
+            self.b[index] = value(b);
+            self.kinetic_factor[index] = value(a / (2.0 * b));
+            self.loss_factor[index] = value((1.0 - det) / (2.0 * b));
+            self.nut_weight[index] = 0.0;
+        }
+        self.count = self.kept + count;
     }
 
     /// The highest frequency a kept mode may have at this sample rate, Hz.
@@ -123,6 +166,7 @@ impl ModeSet {
                 / root;
             self.count = index + 1;
         }
+        self.kept = self.count;
         for index in self.count..MODE_CAPACITY {
             self.stiffness[index] = 0.0;
             self.inverse_root_stiffness[index] = 0.0;
@@ -136,14 +180,15 @@ impl ModeSet {
         }
     }
 
-    /// Writes `Ψ_k(x) = sin(kπx/L)/√κ_k` for every kept mode into `row` (zeros beyond K), by the
+    /// Writes `Ψ_k(x) = sin(kπx/L)/√κ_k` for every kept mode into `row` (zeros beyond K, the
+    /// residual modes included), by the
     /// recurrence `sin((k+1)θ) = 2 cos θ sin(kθ) − sin((k−1)θ)`. Allocation-free.
     pub fn shape_row(&self, x_m: f64, row: &mut [f64]) {
         let theta = PI * x_m / self.length_m;
         let twice_cos = 2.0 * theta.cos();
         let (mut previous, mut current) = (0.0, theta.sin());
         for (index, value) in row.iter_mut().enumerate() {
-            if index < self.count {
+            if index < self.kept {
                 *value = current * self.inverse_root_stiffness[index];
                 let next = twice_cos * current - previous;
                 previous = current;

@@ -13,6 +13,7 @@
 
 use super::lanes::{padded_lanes, Kernels};
 use super::modes::{ModeSet, MODE_CAPACITY};
+use crate::dense::symmetric_eigen_jacobi;
 use crate::tanpura::contact::HuntCrossley;
 use crate::tanpura::geometry::{BridgeSettings, ThreadSettings};
 
@@ -48,6 +49,10 @@ pub struct ContactPoints {
     all_points: Vec<usize>,
     coupling_row: Vec<f64>,
     kept_row: Vec<f64>,
+    /// Scratch of the residual modes: the kept modes' residual compliance on the points and
+    /// its eigenvectors (`capacity × capacity`).
+    eigen_matrix: Vec<f64>,
+    eigen_vectors: Vec<f64>,
 }
 
 /// Points of a grid covering `[start, end]` with the given spacing (at least one).
@@ -79,6 +84,8 @@ impl ContactPoints {
             all_points: (0..capacity).collect(),
             coupling_row: zeros(capacity),
             kept_row: zeros(capacity),
+            eigen_matrix: zeros(capacity * capacity),
+            eigen_vectors: zeros(capacity * capacity),
         }
     }
 
@@ -191,8 +198,9 @@ impl ContactPoints {
         self.residual[i * self.capacity + j]
     }
 
-    /// Recomputes Ψ, G and (with `flexible`) R for the modes (after [`ContactPoints::place`] or
-    /// a change of the string's parameters). Allocation-free; O(M K + M² K), the M² K part as
+    /// Recomputes Ψ (with the residual modes' columns, if `modes` has any), G and (with
+    /// `flexible`) R for the modes (after [`ContactPoints::place`] or a change of the string's
+    /// parameters). Allocation-free; O(M K + M² K), the M² K part as
     /// SIMD dot products (`kernels.dots_pair`): each row i of G and of Ψ Ψᵀ up to the diagonal
     /// is `Ψ_j · (Ψ_i ⊙ b)` and `Ψ_j · Ψ_i` for j ≤ i. It runs on every retune of a ringing
     /// string (each tuning pass), so it is on the audio thread's path.
@@ -205,6 +213,9 @@ impl ContactPoints {
                 x,
                 &mut self.shapes[i * MODE_CAPACITY..(i + 1) * MODE_CAPACITY],
             );
+        }
+        if modes.count() > modes.kept() {
+            self.shape_residual_modes(modes, kernels);
         }
         for i in 0..self.count {
             let row_i = &self.shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + lanes];
@@ -232,6 +243,60 @@ impl ContactPoints {
                 self.coupling[j * self.capacity + i] = sum;
                 self.residual[i * self.capacity + j] = residual;
                 self.residual[j * self.capacity + i] = residual;
+            }
+        }
+    }
+
+    /// The residual modes' shapes at the points (`docs/modal-tanpura.md`, section 8): the
+    /// truncated modes' static compliance on the points, `R = C − Ψ_K Ψ_Kᵀ` (kept modes only;
+    /// symmetric, positive semi-definite), is decomposed `R = Σ_j λ_j v_j v_jᵀ`, and residual mode
+    /// j takes the shape `√λ_j v_j` at the points for the j-th largest λ_j, so that with J modes
+    /// `Ψ Ψᵀ` is the best rank-J completion of the kept modes' compliance towards the continuous
+    /// string's. Needs the kept modes' rows in place; writes the residual columns.
+    fn shape_residual_modes(&mut self, modes: &ModeSet, kernels: &Kernels) {
+        let (kept, count, stride) = (modes.kept(), self.count, self.capacity);
+        let kept_lanes = padded_lanes(kept);
+        for i in 0..count {
+            let row_i = &self.shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + kept_lanes];
+            kernels.dots(
+                &self.shapes,
+                MODE_CAPACITY,
+                &self.all_points[..=i],
+                row_i,
+                &mut self.kept_row[..=i],
+            );
+            for j in 0..=i {
+                let (x_i, x_j) = (self.positions_m[i], self.positions_m[j]);
+                let residual = modes.static_compliance_m_n(x_i, x_j) - self.kept_row[j];
+                self.eigen_matrix[i * stride + j] = residual;
+                self.eigen_matrix[j * stride + i] = residual;
+            }
+        }
+        symmetric_eigen_jacobi(
+            &mut self.eigen_matrix,
+            &mut self.eigen_vectors,
+            count,
+            stride,
+        );
+        // The eigenvalues, largest first: each pick marks its entry taken with −∞.
+        for (i, value) in self.coupling_row[..count].iter_mut().enumerate() {
+            *value = self.eigen_matrix[i * stride + i];
+        }
+        for mode in kept..modes.count() {
+            let largest = (0..count).fold(None, |best: Option<usize>, i| match best {
+                Some(b) if self.coupling_row[b] >= self.coupling_row[i] => Some(b),
+                _ => Some(i),
+            });
+            let (scale, column) = match largest {
+                Some(e) if self.coupling_row[e] > 0.0 => (self.coupling_row[e].sqrt(), e),
+                _ => (0.0, 0),
+            };
+            if let Some(e) = largest {
+                self.coupling_row[e] = f64::NEG_INFINITY;
+            }
+            for i in 0..count {
+                self.shapes[i * MODE_CAPACITY + mode] =
+                    scale * self.eigen_vectors[i * stride + column];
             }
         }
     }
