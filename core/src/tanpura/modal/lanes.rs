@@ -168,6 +168,52 @@ impl<T: Real> WithSimd for FreeStep<'_, T> {
     }
 }
 
+/// Four dot products with one vector, `[r0 · x, r1 · x, r2 · x, r3 · x]`: two accumulators per
+/// row (even and odd registers), so that eight independent multiply-add chains hide the latency
+/// and each load of x serves four rows. The rows are zipped with x, so no access needs a bounds
+/// check.
+#[inline(always)]
+fn four_dots<T: Real, S: Simd>(simd: S, x: &[T::Lanes<S>], rows: [&[T::Lanes<S>]; 4]) -> [f64; 4] {
+    let zero = T::splat(simd, T::default());
+    let mut even = [zero; 4];
+    let mut odd = [zero; 4];
+    let pairs = x
+        .chunks_exact(2)
+        .zip(rows[0].chunks_exact(2))
+        .zip(rows[1].chunks_exact(2))
+        .zip(rows[2].chunks_exact(2))
+        .zip(rows[3].chunks_exact(2));
+    for ((((xk, a), b), c), d) in pairs {
+        even[0] = T::mul_add(simd, a[0], xk[0], even[0]);
+        even[1] = T::mul_add(simd, b[0], xk[0], even[1]);
+        even[2] = T::mul_add(simd, c[0], xk[0], even[2]);
+        even[3] = T::mul_add(simd, d[0], xk[0], even[3]);
+        odd[0] = T::mul_add(simd, a[1], xk[1], odd[0]);
+        odd[1] = T::mul_add(simd, b[1], xk[1], odd[1]);
+        odd[2] = T::mul_add(simd, c[1], xk[1], odd[2]);
+        odd[3] = T::mul_add(simd, d[1], xk[1], odd[3]);
+    }
+    // No closures here: a closure's body is compiled without the caller's target features, so
+    // the vector operations inside it would become calls.
+    let mut sums = [0.0; 4];
+    for j in 0..4 {
+        sums[j] = T::sum(simd, T::add(simd, even[j], odd[j])).to_f64();
+    }
+    sums
+}
+
+/// One dot product in the order of [`four_dots`] (even and odd registers apart).
+#[inline(always)]
+fn one_dot<T: Real, S: Simd>(simd: S, x: &[T::Lanes<S>], row: &[T::Lanes<S>]) -> f64 {
+    let zero = T::splat(simd, T::default());
+    let mut sums = [zero; 2];
+    for (xk, a) in x.chunks_exact(2).zip(row.chunks_exact(2)) {
+        sums[0] = T::mul_add(simd, a[0], xk[0], sums[0]);
+        sums[1] = T::mul_add(simd, a[1], xk[1], sums[1]);
+    }
+    T::sum(simd, T::add(simd, sums[0], sums[1])).to_f64()
+}
+
 /// Dot products of several rows of a matrix with one vector: `out[j] = matrix[rows[j]] · x`.
 struct Dots<'a, T: Real> {
     matrix: &'a [T],
@@ -188,48 +234,57 @@ impl<T: Real> WithSimd for Dots<'_, T> {
             let start = index * self.stride;
             T::lanes::<S>(&self.matrix[start..start + length])
         };
-        let zero = T::splat(simd, T::default());
-        // Four rows per pass, two accumulators each (even and odd registers): eight independent
-        // multiply-add chains hide the latency, and each load of x serves four rows. The rows
-        // are zipped with x, so no access needs a bounds check.
         let mut rows = self.rows.chunks_exact(4);
         let mut outputs = self.out.chunks_exact_mut(4);
         for (indices, out) in (&mut rows).zip(&mut outputs) {
-            let (r0, r1, r2, r3) = (
+            let rows = [
                 row(indices[0]),
                 row(indices[1]),
                 row(indices[2]),
                 row(indices[3]),
-            );
-            let mut even = [zero; 4];
-            let mut odd = [zero; 4];
-            let pairs = x
-                .chunks_exact(2)
-                .zip(r0.chunks_exact(2))
-                .zip(r1.chunks_exact(2))
-                .zip(r2.chunks_exact(2))
-                .zip(r3.chunks_exact(2));
-            for ((((xk, a), b), c), d) in pairs {
-                even[0] = T::mul_add(simd, a[0], xk[0], even[0]);
-                even[1] = T::mul_add(simd, b[0], xk[0], even[1]);
-                even[2] = T::mul_add(simd, c[0], xk[0], even[2]);
-                even[3] = T::mul_add(simd, d[0], xk[0], even[3]);
-                odd[0] = T::mul_add(simd, a[1], xk[1], odd[0]);
-                odd[1] = T::mul_add(simd, b[1], xk[1], odd[1]);
-                odd[2] = T::mul_add(simd, c[1], xk[1], odd[2]);
-                odd[3] = T::mul_add(simd, d[1], xk[1], odd[3]);
-            }
-            for j in 0..4 {
-                out[j] = T::sum(simd, T::add(simd, even[j], odd[j])).to_f64();
-            }
+            ];
+            out.copy_from_slice(&four_dots::<T, S>(simd, x, rows));
         }
         for (&index, out) in rows.remainder().iter().zip(outputs.into_remainder()) {
-            let mut sums = [zero; 2];
-            for (xk, a) in x.chunks_exact(2).zip(row(index).chunks_exact(2)) {
-                sums[0] = T::mul_add(simd, a[0], xk[0], sums[0]);
-                sums[1] = T::mul_add(simd, a[1], xk[1], sums[1]);
-            }
-            *out = T::sum(simd, T::add(simd, sums[0], sums[1])).to_f64();
+            *out = one_dot::<T, S>(simd, x, row(index));
+        }
+    }
+}
+
+/// [`Dots`] of the first `out.len()` rows, walked in order without an index list (every
+/// contact point's free step, each step): `out[j] = matrix[j] · x`, the same sums bit for bit.
+struct LeadingDots<'a, T: Real> {
+    matrix: &'a [T],
+    stride: usize,
+    x: &'a [T],
+    out: &'a mut [f64],
+}
+
+impl<T: Real> WithSimd for LeadingDots<'_, T> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let (length, stride) = (self.x.len(), self.stride);
+        let x = T::lanes::<S>(self.x);
+        let count = self.out.len();
+        let mut groups = self.matrix[..count * stride].chunks_exact(4 * stride);
+        let mut outputs = self.out.chunks_exact_mut(4);
+        for (group, out) in (&mut groups).zip(&mut outputs) {
+            let (first, rest) = group.split_at(stride);
+            let (second, rest) = rest.split_at(stride);
+            let (third, fourth) = rest.split_at(stride);
+            let rows = [
+                T::lanes::<S>(&first[..length]),
+                T::lanes::<S>(&second[..length]),
+                T::lanes::<S>(&third[..length]),
+                T::lanes::<S>(&fourth[..length]),
+            ];
+            out.copy_from_slice(&four_dots::<T, S>(simd, x, rows));
+        }
+        let rest = groups.remainder().chunks_exact(stride);
+        for (row, out) in rest.zip(outputs.into_remainder()) {
+            *out = one_dot::<T, S>(simd, x, T::lanes::<S>(&row[..length]));
         }
     }
 }
@@ -452,6 +507,19 @@ impl Kernels {
         });
     }
 
+    /// `out[j] = matrix[j] · x` for the first `out.len()` rows of the row-major `matrix` whose
+    /// rows start `stride` elements apart: [`Kernels::dots`] with the rows `0, 1, 2, …`, bit for
+    /// bit, without the index list.
+    pub fn leading_dots<T: Real>(&self, matrix: &[T], stride: usize, x: &[T], out: &mut [f64]) {
+        debug_assert!(x.len() <= stride && matrix.len() >= out.len() * stride);
+        self.arch.dispatch(LeadingDots {
+            matrix,
+            stride,
+            x,
+            out,
+        });
+    }
+
     /// `out_x[j] = matrix[rows[j]] · x` and `out_y[j] = matrix[rows[j]] · y`, each row read once;
     /// bit for bit what two calls of [`Kernels::dots`] give.
     #[allow(clippy::too_many_arguments)]
@@ -543,6 +611,12 @@ mod tests {
         for (j, row) in rows.iter().enumerate() {
             let plain: f64 = row.iter().zip(&s).map(|(x, y)| x * y).sum();
             assert!((dots[j] - plain).abs() < 1e-13, "row {j}");
+        }
+        // The leading rows without an index list give the same sums bit for bit.
+        for count in [1, 4, rows.len()] {
+            let mut leading = vec![0.0; count];
+            kernels.leading_dots(&matrix, n, &s, &mut leading);
+            assert_eq!(leading, dots[..count]);
         }
         // The paired kernel gives each of the two dot products bit for bit, for an even and an
         // odd number of rows.

@@ -435,13 +435,11 @@ impl<T: Real> ModalString<T> {
         // The kernels run over the kept modes, padded to whole registers; `step` holds s_free.
         let lanes = self.lanes;
         // Every point's free step Ψ_i s_free, one dot product per point.
-        let (rows, free_steps) = self.contact.point_rows(self.points.len());
-        self.kernels.dots(
+        self.kernels.leading_dots(
             &self.shapes,
             MODE_CAPACITY,
-            rows,
             &self.step[..lanes],
-            free_steps,
+            self.contact.point_free_steps_mut(self.points.len()),
         );
         let (iterations, converged) = self.contact.solve(&self.points, &self.config.newton);
         self.stats.record(iterations, converged);

@@ -46,8 +46,7 @@ pub struct ContactStep {
     /// 0 for a far point, −∞ for a tracked one: added to a gap, it keeps every test on far
     /// points from selecting a tracked point, in loops without branches.
     far_offsets_m: Vec<f64>,
-    /// Every point's index, the rows of the free-step kernel, and `Ψ_i s_free` per point, m.
-    all_points: Vec<usize>,
+    /// `Ψ_i s_free` per point, m.
     point_free_steps_m: Vec<f64>,
     /// This step's `Σ_j G_ij ΔF_j` per point, m.
     coupled_m: Vec<f64>,
@@ -104,7 +103,6 @@ impl ContactStep {
             capacity,
             gaps_m: zeros(),
             far_offsets_m: zeros(),
-            all_points: (0..capacity).collect(),
             point_free_steps_m: zeros(),
             coupled_m: zeros(),
             slots: vec![UNTRACKED; capacity],
@@ -136,13 +134,10 @@ impl ContactStep {
         }
     }
 
-    /// The first `count` points' indices, and where their free steps `Ψ_i s_free` go (every
-    /// step, before [`ContactStep::solve`]).
-    pub fn point_rows(&mut self, count: usize) -> (&[usize], &mut [f64]) {
-        (
-            &self.all_points[..count],
-            &mut self.point_free_steps_m[..count],
-        )
+    /// Where the first `count` points' free steps `Ψ_i s_free` go (every step, before
+    /// [`ContactStep::solve`]).
+    pub fn point_free_steps_mut(&mut self, count: usize) -> &mut [f64] {
+        &mut self.point_free_steps_m[..count]
     }
 
     pub fn tracked_count(&self) -> usize {
@@ -239,7 +234,7 @@ impl ContactStep {
     }
 
     /// Solves the step's contact (every point's free step must be in place, from
-    /// [`ContactStep::point_rows`]). A far point that would touch during the step joins and the
+    /// [`ContactStep::point_free_steps_mut`]). A far point that would touch during the step joins and the
     /// solve is redone. Returns (Newton updates, converged).
     pub fn solve(&mut self, points: &ContactPoints, settings: &NewtonSettings) -> (u32, bool) {
         for slot in 0..self.count {
