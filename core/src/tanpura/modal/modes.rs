@@ -181,8 +181,8 @@ impl ModeSet {
     }
 
     /// Writes `Ψ_k(x) = sin(kπx/L)/√κ_k` for every kept mode into `row` (zeros beyond K, the
-    /// residual modes included), by the
-    /// recurrence `sin((k+1)θ) = 2 cos θ sin(kθ) − sin((k−1)θ)`. Allocation-free.
+    /// residual modes included), by the recurrence `sin((k+1)θ) = 2 cos θ sin(kθ) −
+    /// sin((k−1)θ)`. Allocation-free.
     pub fn shape_row(&self, x_m: f64, row: &mut [f64]) {
         let theta = PI * x_m / self.length_m;
         let twice_cos = 2.0 * theta.cos();
