@@ -18,12 +18,14 @@
 //!
 //! **Which points Newton sees.** Only the *tracked* points, those within the tracking band of
 //! contact or loaded at rest, take part; their state lives in compact arrays in slot order, with
-//! their block of G, so Newton touches no index list and no other point. Every point's free step
-//! `Ψ_i s_free` is computed each step (one dot product per point, in the mode kernels), so every
-//! other (far) point's step is known exactly once the forces are, `Ψ_i s_free + Σ_j G_ij ΔF_j`,
-//! and its gap follows it. One pass over all points, in plain arrays the compiler vectorises,
-//! checks whether a far point would touch; if one would, it joins and the solve is redone before
-//! anything moves, so the solve is exact for every point.
+//! their block of G, so Newton touches no index list and no other point. Every awake point's free
+//! step `Ψ_i s_free` is computed each step (one dot product per point, in the mode kernels), so
+//! every other (far) point's step is known exactly once the forces are, `Ψ_i s_free + Σ_j G_ij
+//! ΔF_j`, and its gap follows it. Far points that the string's energy cannot carry into contact
+//! before its next excitation sleep ([`ContactStep::sleep_far_points`]). One pass over all
+//! points, in plain arrays the compiler vectorises, checks whether a far point would touch; if one
+//! would, it joins and the solve is redone before anything moves, so the solve is exact for every
+//! point.
 //!
 //! Hand-written rather than on a linear-algebra crate: the systems are 1–12 points, solved once
 //! or twice per sample on the audio thread; the fixed-size LDLᵀ of `solve.rs` is unrolled by the
@@ -36,6 +38,9 @@ use crate::tanpura::contact::HuntCrossley;
 
 /// The slot of a point that is not tracked.
 const UNTRACKED: usize = usize::MAX;
+/// A point sleeps only if its gap provably stays this far below contact (more than the tracking
+/// band, so a sleeping point is never one that would be tracked).
+const SLEEP_MARGIN_M: f64 = 10e-6;
 
 /// Per-step state of the contact points; allocation-free after `new`.
 #[derive(Debug, Clone)]
@@ -48,6 +53,12 @@ pub struct ContactStep {
     far_offsets_m: Vec<f64>,
     /// `Ψ_i s_free` per point, m.
     point_free_steps_m: Vec<f64>,
+    /// 1 for an awake point, 0 for a sleeping one (see [`ContactStep::sleep_far_points`]); the
+    /// awake points in order, and their free steps as the kernel writes them.
+    awake: Vec<f64>,
+    awake_points: Vec<usize>,
+    awake_count: usize,
+    awake_free_steps_m: Vec<f64>,
     /// This step's `Σ_j G_ij ΔF_j` per point, m.
     coupled_m: Vec<f64>,
     /// Each point's slot among the tracked, or [`UNTRACKED`].
@@ -104,6 +115,10 @@ impl ContactStep {
             gaps_m: zeros(),
             far_offsets_m: zeros(),
             point_free_steps_m: zeros(),
+            awake: vec![1.0; capacity],
+            awake_points: (0..capacity).collect(),
+            awake_count: 0,
+            awake_free_steps_m: zeros(),
             coupled_m: zeros(),
             slots: vec![UNTRACKED; capacity],
             tracked: vec![0; capacity],
@@ -135,9 +150,71 @@ impl ContactStep {
     }
 
     /// Where the first `count` points' free steps `Ψ_i s_free` go (every step, before
-    /// [`ContactStep::solve`]).
-    pub fn point_free_steps_mut(&mut self, count: usize) -> &mut [f64] {
-        &mut self.point_free_steps_m[..count]
+    /// [`ContactStep::solve`]) when every point is awake, or `None`.
+    pub fn point_free_steps_mut(&mut self, count: usize) -> Option<&mut [f64]> {
+        (self.awake_count == count).then_some(&mut self.point_free_steps_m[..count])
+    }
+
+    /// The awake points, and where their free steps go in that order (then
+    /// [`ContactStep::spread_awake_free_steps`]).
+    pub fn awake_rows(&mut self) -> (&[usize], &mut [f64]) {
+        let count = self.awake_count;
+        (
+            &self.awake_points[..count],
+            &mut self.awake_free_steps_m[..count],
+        )
+    }
+
+    /// Puts the awake points' free steps in their places (the sleeping points' stay 0).
+    pub fn spread_awake_free_steps(&mut self) {
+        for (&i, &step) in self.awake_points[..self.awake_count]
+            .iter()
+            .zip(&self.awake_free_steps_m)
+        {
+            self.point_free_steps_m[i] = step;
+        }
+    }
+
+    /// How many points are awake.
+    pub fn awake_count(&self) -> usize {
+        self.awake_count
+    }
+
+    /// Whether point i is awake.
+    pub fn is_awake(&self, i: usize) -> bool {
+        self.awake[i] != 0.0
+    }
+
+    /// Puts to sleep every far point that cannot touch before the string is next excited from
+    /// outside: one with no force at rest, not tracked, and `‖Ψ_i‖ reach < −a_rest,i − margin`,
+    /// where `reach` bounds `‖r̃‖` until then. (With the vibration energy H_v, which no step
+    /// increases (eq. M3), `‖r̃‖² ≤ 2 H_v`, so `|Ψ_i r̃| ≤ ‖Ψ_i‖ √(2 H_v)` and the point's gap
+    /// `a_rest,i − Ψ_i r̃` stays below −margin.) A sleeping point's free step is not computed, its
+    /// gap is frozen and it never joins; [`ContactStep::classify`], which every change of the
+    /// state from outside ends in, wakes every point.
+    pub fn sleep_far_points(&mut self, points: &ContactPoints, shape_norms: &[f64], reach: f64) {
+        let mut changed = false;
+        for i in 0..points.len() {
+            let asleep = self.awake[i] != 0.0
+                && self.slots[i] == UNTRACKED
+                && points.rest_forces_n[i] == 0.0
+                && shape_norms[i] * reach < -points.rest_gaps_m[i] - SLEEP_MARGIN_M;
+            if asleep {
+                self.awake[i] = 0.0;
+                self.far_offsets_m[i] = f64::NEG_INFINITY;
+                self.point_free_steps_m[i] = 0.0;
+                changed = true;
+            }
+        }
+        if changed {
+            self.awake_count = 0;
+            for i in 0..points.len() {
+                if self.awake[i] != 0.0 {
+                    self.awake_points[self.awake_count] = i;
+                    self.awake_count += 1;
+                }
+            }
+        }
     }
 
     pub fn tracked_count(&self) -> usize {
@@ -159,7 +236,10 @@ impl ContactStep {
             self.slots[self.tracked[slot]] = UNTRACKED;
         }
         self.count = 0;
+        self.awake_count = points.len();
         for i in 0..points.len() {
+            self.awake[i] = 1.0;
+            self.awake_points[i] = i;
             self.far_offsets_m[i] = 0.0;
             if self.gaps_m[i] > -band_m || points.rest_forces_n[i] != 0.0 {
                 self.track(points, i, self.gaps_m[i], 0.0, 0.0);
@@ -310,7 +390,7 @@ impl ContactStep {
         for i in 0..count {
             let step = self.point_free_steps_m[i] + self.coupled_m[i];
             let gap = self.gaps_m[i];
-            if self.slots[i] == UNTRACKED && gap - step > 0.0 {
+            if self.slots[i] == UNTRACKED && self.awake[i] != 0.0 && gap - step > 0.0 {
                 self.track(
                     points,
                     i,
@@ -330,12 +410,12 @@ impl ContactStep {
     pub fn finish_step(&mut self, points: &ContactPoints) -> f64 {
         let count = points.len();
         // Every point by its step at the converged forces; the tracked ones by Newton's below.
-        for ((gap, &free_step), &coupled) in self.gaps_m[..count]
+        for ((gap, &free_step), (&coupled, &awake)) in self.gaps_m[..count]
             .iter_mut()
             .zip(&self.point_free_steps_m[..count])
-            .zip(&self.coupled_m[..count])
+            .zip(self.coupled_m[..count].iter().zip(&self.awake[..count]))
         {
-            *gap -= free_step + coupled;
+            *gap -= (free_step + coupled) * awake;
         }
         let mut penetration = 0.0f64;
         for slot in 0..self.count {
@@ -375,7 +455,7 @@ impl ContactStep {
         }
         for i in 0..count {
             let gap = self.gaps_m[i];
-            if self.slots[i] == UNTRACKED && gap > -band_m {
+            if self.slots[i] == UNTRACKED && self.awake[i] != 0.0 && gap > -band_m {
                 self.track(points, i, gap, 0.0, 0.0);
             }
         }
