@@ -455,7 +455,8 @@ impl<T: Real> ModalString<T> {
     pub fn step(&mut self) {
         // The kernels run over the kept modes, padded to whole registers; `step` holds s_free.
         let lanes = self.lanes;
-        // Every point's free step Ψ_i s_free, one dot product per point.
+        // Every awake point's free step Ψ_i s_free, one dot product per point; far points are
+        // put to sleep every SLEEP_CHECK_STEPS steps.
         self.steps_since_sleep_check += 1;
         if self.steps_since_sleep_check >= SLEEP_CHECK_STEPS {
             self.steps_since_sleep_check = 0;
@@ -803,9 +804,10 @@ impl<T: Real> ModalString<T> {
         (&self.modal[..count], &self.velocity[..count])
     }
 
-    /// The gaps a_i of the points after the last step, m (positive: the string penetrates),
-    /// each carried by its step (`a_rest,i − Ψ_i r̃` to within a few nanometres of round-off,
-    /// tested); [`ModalString::displacement_at_m`] gives the shape anywhere.
+    /// The gaps a_i of the points after the last step, m (positive: the string penetrates):
+    /// an awake point's carried by its step (`a_rest,i − Ψ_i r̃` to within a few nanometres of
+    /// round-off, tested), a sleeping point's as it fell asleep (its true gap stays at least
+    /// 10 µm short of contact); [`ModalString::displacement_at_m`] gives the shape anywhere.
     pub fn gaps_m(&self) -> &[f64] {
         &self.contact.gaps_m[..self.points.len()]
     }
@@ -892,7 +894,7 @@ mod tests {
 
     /// The gaps a step carries forward by the points' steps (`ContactStep::finish_step`) stay
     /// those of the modal state, `a_rest,i − Ψ_i r̃`, at every awake point over a long ring in
-    /// single precision, although no gap is recomputed between plucks. Measured: at most 2.4 nm
+    /// single precision, although no gap is recomputed between plucks. Measured: at most 2.1 nm
     /// (the tracked points' Newton steps and the f32 state's rounding), reached within the first
     /// 3 s and not growing after. Every sleeping point's true gap stays below its margin, and
     /// points do fall asleep as the string decays.
