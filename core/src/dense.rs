@@ -1,5 +1,6 @@
 //! Cholesky factorisation of small dense symmetric positive definite matrices, allocation-free
-//! after construction.
+//! after construction, and the eigen-decomposition of small symmetric matrices by Jacobi
+//! rotations (the modal string's residual modes, `tanpura/modal/points.rs`).
 //!
 //! Both tanpura discretisations solve a small SPD system per Newton update on the contact region:
 //! the FD tiers the Schur complement of the step matrix on the ~14 contact nodes
