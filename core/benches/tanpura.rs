@@ -2,7 +2,7 @@
 //! four-string instrument, and the reference FD string's two Newton solvers (divan).
 //!
 //! `cargo bench -p javari-core --bench tanpura` (one group: `-- one_string`, `-- four_strings`,
-//! `-- fd_string`).
+//! `-- fd_string`, `-- free_steps`).
 //!
 //! **Reading the figures.** Every benchmark iteration renders one fixed block of 0.1 s: 4410
 //! output samples at 44.1 kHz ([`BLOCK_SAMPLES`]), or for `fd_string` the 17 640 FD steps of 0.1 s
@@ -24,6 +24,8 @@
 //!   strings plucked together, one `Tanpura::next_sample` per output sample, at both tiers.
 //! - `fd_string`: the reference [`FdString`] stepped alone (no voice, no decimator) with the
 //!   condensed solver and with the plain full Newton.
+//! - `free_steps`: one call of the live tier's free-step kernel, its matrix on a cache line and
+//!   16 bytes off it (the time per iteration is the kernel's, not 0.1 s of audio).
 //!
 //! Newton's iteration counts are not reported here (`cargo xtask bench` and `cargo xtask simulate`
 //! give them). Nothing here asserts: speed is measured, never tested (house style 13). Under
@@ -31,6 +33,7 @@
 
 use divan::counter::ItemsCount;
 use divan::{black_box, Bencher};
+use javari_core::simd::{CacheAligned, Kernels};
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::fd::{FdString, FdStringConfig, SolverKind};
 use javari_core::tanpura::quality::Quality;
@@ -115,4 +118,29 @@ fn fd_string(bencher: Bencher, solver: SolverKind) {
             }
             black_box(string.nut_force_n());
         });
+}
+
+/// Bytes by which the free-step matrix is moved off a cache line in [`free_steps`].
+const MISALIGNMENTS_BYTES: [usize; 2] = [0, 16];
+
+/// The modal live tier's free-step kernel alone (`Kernels::leading_dots`: 36 contact points'
+/// rows of 96 f32 modes, row stride 128, against one vector), with the matrix starting on a
+/// cache line and 16 bytes off it: what `simd::CacheAligned` buys. One call per iteration.
+#[divan::bench(args = MISALIGNMENTS_BYTES)]
+fn free_steps(bencher: Bencher, misalignment_bytes: usize) {
+    const POINTS: usize = 36;
+    const STRIDE: usize = 128;
+    const LANES: usize = 96;
+    let offset = misalignment_bytes / std::mem::size_of::<f32>();
+    let mut storage = CacheAligned::new(POINTS * STRIDE + offset, 0.0f32);
+    for (index, value) in storage[offset..].iter_mut().enumerate() {
+        *value = (index as f32 * 0.01).sin();
+    }
+    let x: Vec<f32> = (0..LANES).map(|k| (k as f32 * 0.3).cos()).collect();
+    let kernels = Kernels::detect();
+    let mut out = [0.0f64; POINTS];
+    bencher.bench_local(|| {
+        kernels.leading_dots(black_box(&storage[offset..]), STRIDE, &x, &mut out);
+        black_box(&out);
+    });
 }

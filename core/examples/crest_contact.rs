@@ -13,6 +13,9 @@
 //!    the pluck (8192-sample Hann frames, dB of the output's power), and the live tier's
 //!    third-octave levels above 1 kHz against the reference's, as the bench's spectral distance
 //!    measures them.
+//! 3. The seed's string at rest with 0 to 8 residual modes and bridge points 1 to 0.25 mm apart:
+//!    the deepest bridge gap, the points on the crest, and the time of a change of configuration
+//!    (the thread moved; best of 20).
 //!
 //! The figures are quoted in `docs/modal-tanpura.md`, section 8; the contrast of part 1 (the kept
 //! modes alone strike the crest to the end, residual modes settle on it) is asserted by
@@ -223,8 +226,50 @@ fn band_differences() {
     }
 }
 
+/// The rest contact on the crest with 0 to 8 residual modes and bridge points 1 to 0.25 mm apart,
+/// and what a change of configuration (the thread moved by 0.1 mm and back) costs with them.
+fn residual_modes_at_rest() {
+    println!();
+    println!("Residual modes: the seed's string at rest on the crest");
+    println!("| bridge points | residual modes | deepest bridge gap | points on the crest | set_config |");
+    println!("|---|---|---|---|---|");
+    for spacing_m in [1e-3, 0.5e-3, 0.25e-3] {
+        for residual_modes in [0, 1, 2, 4, 8] {
+            let config = ModalStringConfig {
+                residual_modes,
+                bridge_point_spacing_m: spacing_m,
+                ..ModalStringConfig::REFERENCE
+            };
+            let mut string = ModalString::<f32>::new(config);
+            let bridge = string.bridge_point_count();
+            let gaps = &string.gaps_m()[..bridge];
+            let deepest = gaps.iter().cloned().fold(f64::MIN, f64::max);
+            let touching = gaps.iter().filter(|&&gap| gap > 0.0).count();
+            // Best of 20 changes of the thread's position, each followed by one step.
+            let mut fastest = f64::MAX;
+            for change in 0..20 {
+                let mut moved = config;
+                if let Some(thread) = moved.thread.as_mut() {
+                    thread.position_m += if change % 2 == 0 { 1e-4 } else { 0.0 };
+                }
+                let start = std::time::Instant::now();
+                string.set_config(moved);
+                fastest = fastest.min(start.elapsed().as_secs_f64());
+                string.step();
+            }
+            println!(
+                "| {:.2} mm | {residual_modes} | {:+.2} µm | {touching} | {:.0} µs |",
+                spacing_m * 1e3,
+                deepest * 1e6,
+                fastest * 1e6
+            );
+        }
+    }
+}
+
 fn main() {
     contact_census();
     high_band();
     band_differences();
+    residual_modes_at_rest();
 }

@@ -121,8 +121,8 @@ pub fn symmetric_eigen_jacobi(matrix: &mut [f64], vectors: &mut [f64], size: usi
                 }
                 let (app, aqq) = (matrix[p * stride + p], matrix[q * stride + q]);
                 let theta = (aqq - app) / (2.0 * apq);
+                // signum(0) = 1: equal diagonals rotate by π/4.
                 let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let t = if theta == 0.0 { 1.0 } else { t };
                 let c = 1.0 / (t * t + 1.0).sqrt();
                 let s = t * c;
                 for k in 0..size {

@@ -40,11 +40,12 @@ impl Kernels {
 
 /// A fixed-length array of `T` whose first element lies on a cache line (64 bytes), for the
 /// arrays the kernels stream through: a 512-bit load from an address that is not a multiple of
-/// 64 spans two cache lines, and a mode kernel takes up to half again as long on such arrays
-/// (measured with AVX-512 on AMD EPYC: the modal string's 36 free steps as a mode-major kernel,
-/// 61 ns aligned against 94 ns misaligned by 16 bytes; `docs/performance.md`). `Vec` only promises the alignment of `T`, so the storage holds one
-/// cache line more and the slice starts at its first aligned element, found again at each
-/// access (the storage never moves while the array lives; a clone finds its own).
+/// 64 spans two cache lines, and the modal string's free-step kernel takes 45 % longer on such
+/// an array (divan, `cargo bench -p javari-core --bench tanpura -- free_steps`, AVX-512 on AMD
+/// EPYC: 47.8 ns on a cache line, 69.3 ns 16 bytes off it). `Vec` only promises the alignment of
+/// `T`, so the storage holds one cache line more and the slice starts at its first aligned
+/// element, found again at each access (the storage never moves while the array lives; a clone
+/// finds its own).
 pub struct CacheAligned<T> {
     storage: Vec<T>,
     len: usize,

@@ -199,7 +199,8 @@ pub struct ModalString<T: Real> {
     kernels: Kernels,
     /// The kept modes rounded up to whole registers: the length the kernels run over.
     lanes: usize,
-    // The mode arrays the kernels run on (T), MODE_CAPACITY long, zero beyond the kept modes.
+    // The mode arrays the kernels run on (T), MODE_CAPACITY long, zero beyond the modes the step
+    // advances (the kept ones and any residual ones), each starting on a cache line.
     a: CacheAligned<T>,
     b: CacheAligned<T>,
     nut_weights: CacheAligned<T>,

@@ -283,16 +283,14 @@ impl ContactPoints {
             *value = self.eigen_matrix[i * stride + i];
         }
         for mode in kept..modes.count() {
-            let largest = (0..count).fold(None, |best: Option<usize>, i| match best {
-                Some(b) if self.coupling_row[b] >= self.coupling_row[i] => Some(b),
-                _ => Some(i),
-            });
+            let eigenvalues = &mut self.coupling_row[..count];
+            let largest = (0..count).max_by(|&a, &b| eigenvalues[a].total_cmp(&eigenvalues[b]));
             let (scale, column) = match largest {
-                Some(e) if self.coupling_row[e] > 0.0 => (self.coupling_row[e].sqrt(), e),
+                Some(e) if eigenvalues[e] > 0.0 => (eigenvalues[e].sqrt(), e),
                 _ => (0.0, 0),
             };
             if let Some(e) = largest {
-                self.coupling_row[e] = f64::NEG_INFINITY;
+                eigenvalues[e] = f64::NEG_INFINITY;
             }
             for i in 0..count {
                 self.shapes[i * MODE_CAPACITY + mode] =

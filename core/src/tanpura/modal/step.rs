@@ -48,8 +48,8 @@ pub struct ContactStep {
     capacity: usize,
     /// a_i per point, m, after every step.
     pub gaps_m: Vec<f64>,
-    /// 0 for a far point, −∞ for a tracked one: added to a gap, it keeps every test on far
-    /// points from selecting a tracked point, in loops without branches.
+    /// 0 for an awake far point, −∞ for a tracked or a sleeping one: added to a gap, it keeps
+    /// every test on far points from selecting any other point.
     far_offsets_m: Vec<f64>,
     /// `Ψ_i s_free` per point, m.
     point_free_steps_m: Vec<f64>,
@@ -384,13 +384,14 @@ impl ContactStep {
         if !touches {
             return false;
         }
-        // The same test point by point; the solve is redone only if a point did join, so the
-        // loop in `solve` ends whatever the values.
+        // The same test point by point (the offset leaves out the tracked and the sleeping
+        // points); the solve is redone only if a point did join, so the loop in `solve` ends
+        // whatever the values.
         let mut joined = false;
         for i in 0..count {
             let step = self.point_free_steps_m[i] + self.coupled_m[i];
             let gap = self.gaps_m[i];
-            if self.slots[i] == UNTRACKED && self.awake[i] != 0.0 && gap - step > 0.0 {
+            if (gap + self.far_offsets_m[i]) - step > 0.0 {
                 self.track(
                     points,
                     i,
@@ -455,7 +456,7 @@ impl ContactStep {
         }
         for i in 0..count {
             let gap = self.gaps_m[i];
-            if self.slots[i] == UNTRACKED && self.awake[i] != 0.0 && gap > -band_m {
+            if gap + self.far_offsets_m[i] > -band_m {
                 self.track(points, i, gap, 0.0, 0.0);
             }
         }
