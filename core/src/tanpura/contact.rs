@@ -127,7 +127,7 @@ impl HuntCrossley {
     /// positive, so the scheme stays dissipative; and while the point stays in contact (or out)
     /// the force is *linear* in s, so a step in which no point changes its contact case is solved
     /// exactly by one Newton update. `squared_gap_change` is Φ as before, for the energy.
-    #[inline]
+    #[inline(always)]
     pub fn midpoint_force_linear_damping(&self, gap: f64, step: f64) -> ContactForce {
         let gap_after = gap - step;
         let damping = 2.0 * self.psi * gap.max(0.0);
@@ -164,7 +164,7 @@ impl HuntCrossley {
 
     /// The energy the linearly implicit damping dissipates over a step `s` from gap `a`, in the
     /// law's units times metres: `2ψ ⌊a⌋ s² ≥ 0`.
-    #[inline]
+    #[inline(always)]
     pub fn linear_damping_loss(&self, gap: f64, step: f64) -> f64 {
         2.0 * self.psi * gap.max(0.0) * step * step
     }

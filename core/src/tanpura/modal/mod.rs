@@ -477,13 +477,22 @@ impl<T: Real> ModalString<T> {
             );
             self.contact.spread_awake_free_steps();
         }
-        let (iterations, converged) = self.contact.solve(&self.points, &self.config.newton);
-        self.stats.record(iterations, converged);
+        // The contact solve, and the tracking for the next step (which reads only the gaps and
+        // forces, not the modes).
+        let outcome = self.contact.step(
+            &self.points,
+            &self.config.newton,
+            self.config.track_energy,
+            &self.kernels,
+            TRACKING_BAND_M,
+            2.0 * TRACKING_BAND_M,
+        );
+        self.stats.record(outcome.iterations, outcome.converged);
         if self.config.track_energy {
             // Contact damping at this step's forces; the modes' loss needs the whole step below.
-            self.cumulative_losses_j += self.contact.damping_loss_j();
+            self.cumulative_losses_j += outcome.damping_loss_j;
         }
-        let penetration = self.contact.finish_step(&self.points);
+        let penetration = outcome.penetration_m;
 
         let (loaded, changes) = self.contact.loaded();
         let mut bridge_change = 0.0;
@@ -512,8 +521,6 @@ impl<T: Real> ModalString<T> {
                 })
                 .sum::<f64>();
         }
-        self.contact
-            .update_tracking(&self.points, TRACKING_BAND_M, 2.0 * TRACKING_BAND_M);
         self.nut_force_change_n = nut_change;
         self.bridge_force_change_n = bridge_change;
         self.max_penetration_m = penetration;

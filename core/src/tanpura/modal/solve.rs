@@ -70,6 +70,7 @@ pub(super) fn ldl_solve_fixed<const N: usize>(matrix: &mut [[f64; N]; N], x: &mu
 
 /// The LDLᵀ factorisation of [`ldl_solve_fixed`], written over `matrix`: `L` below the diagonal,
 /// `D` on it.
+#[inline(always)]
 pub(super) fn ldl_factor_fixed<const N: usize>(matrix: &mut [[f64; N]; N]) {
     let mut weighted = [0.0; N];
     for j in 0..N {
@@ -91,6 +92,7 @@ pub(super) fn ldl_factor_fixed<const N: usize>(matrix: &mut [[f64; N]; N]) {
 }
 
 /// Solves with the factors of [`ldl_factor_fixed`]: `L y = b`, `D z = y`, `Lᵀ x = z`, in place.
+#[inline(always)]
 pub(super) fn ldl_substitute_fixed<const N: usize>(factors: &[[f64; N]; N], x: &mut [f64; N]) {
     for i in 0..N {
         for k in 0..i {

@@ -34,7 +34,9 @@
 use super::points::ContactPoints;
 use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
 use crate::newton::NewtonSettings;
+use crate::simd::Kernels;
 use crate::tanpura::contact::HuntCrossley;
+use pulp::{Simd, WithSimd};
 
 /// The slot of a point that is not tracked.
 const UNTRACKED: usize = usize::MAX;
@@ -98,6 +100,54 @@ pub struct ContactStep {
     /// The loaded points as point indices and their F − F_rest, N: what the modes feel.
     loaded_points: Vec<usize>,
     loaded_changes_n: Vec<f64>,
+}
+
+/// What one step's contact work ([`ContactStep::step`]) reports.
+#[derive(Debug, Clone, Copy)]
+pub struct ContactOutcome {
+    /// Newton updates, and whether the last met the tolerance.
+    pub iterations: u32,
+    pub converged: bool,
+    /// The contact damping's loss over the step, J (0 unless asked for).
+    pub damping_loss_j: f64,
+    /// The deepest penetration of the tracked points after the step (0 if none), m.
+    pub penetration_m: f64,
+}
+
+/// The contact work of one step ([`ContactStep::step`]) as one function compiled for the
+/// machine's vector unit: every method it calls is inlined into it, so its scalar arithmetic
+/// uses the unit's fused multiply-adds and VEX encoding, and its passes over all points run in
+/// the unit's full width.
+struct ContactPass<'a> {
+    contact: &'a mut ContactStep,
+    points: &'a ContactPoints,
+    settings: &'a NewtonSettings,
+    track_energy: bool,
+    band_m: f64,
+    release_m: f64,
+}
+
+impl WithSimd for ContactPass<'_> {
+    type Output = ContactOutcome;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> ContactOutcome {
+        let contact = self.contact;
+        let (iterations, converged) = contact.solve(self.points, self.settings);
+        let damping_loss_j = if self.track_energy {
+            contact.damping_loss_j()
+        } else {
+            0.0
+        };
+        let penetration_m = contact.finish_step(self.points);
+        contact.update_tracking(self.points, self.band_m, self.release_m);
+        ContactOutcome {
+            iterations,
+            converged,
+            damping_loss_j,
+            penetration_m,
+        }
+    }
 }
 
 /// Whether a point is in contact before and after a step `step` from gap `gap`.
@@ -313,9 +363,32 @@ impl ContactStep {
         self.block[slot * stride + slot] = self.block[last * stride + last];
     }
 
+    /// One step's contact work on the vector unit of `kernels`: [`ContactStep::solve`], the
+    /// damping loss (with `track_energy`), [`ContactStep::finish_step`] and
+    /// [`ContactStep::update_tracking`] with `band_m` and `release_m`.
+    pub fn step(
+        &mut self,
+        points: &ContactPoints,
+        settings: &NewtonSettings,
+        track_energy: bool,
+        kernels: &Kernels,
+        band_m: f64,
+        release_m: f64,
+    ) -> ContactOutcome {
+        kernels.arch.dispatch(ContactPass {
+            contact: self,
+            points,
+            settings,
+            track_energy,
+            band_m,
+            release_m,
+        })
+    }
+
     /// Solves the step's contact (every point's free step must be in place, from
     /// [`ContactStep::point_free_steps_mut`]). A far point that would touch during the step joins and the
     /// solve is redone. Returns (Newton updates, converged).
+    #[inline(always)]
     pub fn solve(&mut self, points: &ContactPoints, settings: &NewtonSettings) -> (u32, bool) {
         for slot in 0..self.count {
             let free_step = self.point_free_steps_m[self.tracked[slot]];
@@ -346,6 +419,7 @@ impl ContactStep {
     /// Forms every point's `Σ_j G_ij ΔF_j` at the current forces; a far point whose step
     /// `Ψ_i s_free + Σ_j G_ij ΔF_j` would bring it into contact joins (returns true: the solve
     /// must be redone).
+    #[inline(always)]
     fn join_touching(&mut self, points: &ContactPoints) -> bool {
         let count = points.len();
         let stride = self.capacity;
@@ -408,6 +482,7 @@ impl ContactStep {
     /// After the solve: moves the tracked gaps by the accepted steps, keeps the corrections for
     /// the next guess and the far bounds for the next step. Returns the deepest penetration of
     /// the tracked points after the step (0 if none), m.
+    #[inline(always)]
     pub fn finish_step(&mut self, points: &ContactPoints) -> f64 {
         let count = points.len();
         // Every point by its step at the converged forces; the tracked ones by Newton's below.
@@ -431,6 +506,7 @@ impl ContactStep {
 
     /// After a step: tracked points farther than `release_m` from contact with no force now and
     /// none at rest leave; far points within `band_m` of contact join.
+    #[inline(always)]
     pub fn update_tracking(&mut self, points: &ContactPoints, band_m: f64, release_m: f64) {
         let mut slot = 0;
         while slot < self.count {
@@ -464,6 +540,7 @@ impl ContactStep {
 
     /// Evaluates every tracked point's force at the iterate and lists the slots whose force
     /// differs from its rest value.
+    #[inline(always)]
     fn evaluate(&mut self) {
         let count = self.count;
         self.loaded_count = 0;
@@ -484,6 +561,7 @@ impl ContactStep {
     /// Whether no point can exert a force different from its rest force during the free step:
     /// nothing rests in contact and nothing touches before or after. Then the free step is the
     /// exact solution and the forces are zero.
+    #[inline(always)]
     fn settle_if_free(&mut self) -> bool {
         let count = self.count;
         let free = self.rest_forces[..count]
@@ -501,6 +579,7 @@ impl ContactStep {
     }
 
     /// Newton's iteration from the current steps: at most `settings.max_iterations` updates.
+    #[inline(always)]
     fn newton(&mut self, settings: &NewtonSettings) -> (u32, bool) {
         let cap = settings.max_iterations.max(1);
         for iteration in 1..=cap {
@@ -522,6 +601,7 @@ impl ContactStep {
     }
 
     /// Whether every tracked point is in the same contact case before and after its step.
+    #[inline(always)]
     fn cases_unchanged(&self) -> bool {
         self.gaps[..self.count]
             .iter()
@@ -534,6 +614,7 @@ impl ContactStep {
 
     /// How many tracked points enter or leave contact during their step (the law is nonlinear
     /// only there), and the slot of the last of them.
+    #[inline(always)]
     fn crossing_points(&self) -> (usize, usize) {
         let mut count = 0;
         let mut last = 0;
@@ -557,6 +638,7 @@ impl ContactStep {
     /// `c > 0` (the others' rows of `I + D G D` are identity rows). With `crossing` (the one
     /// point that enters or leaves contact during its step), the step is first solved exactly
     /// for the cases of the evaluation point ([`ContactStep::finish_exactly`]).
+    #[inline(always)]
     fn update(&mut self, crossing: Option<usize>) -> (f64, bool) {
         let count = self.count;
         let stride = self.capacity;
@@ -646,6 +728,7 @@ impl ContactStep {
     /// solves the scheme's equations to round-off. Otherwise `None`, and Newton goes on.
     /// Newton's own iterates converge to the same root quadratically but from far away, one
     /// update for every digit pair (3–4 more updates per crossing with stiff contact).
+    #[inline(always)]
     fn finish_exactly(&mut self, crossing: usize, size: usize) -> Option<f64> {
         let count = self.count;
         let stride = self.capacity;
@@ -724,6 +807,7 @@ impl ContactStep {
     /// `(I + D G_AA D) y = −D R_A`, then `y ← D y`, into `solution[..N]`, for exactly `N` active
     /// points (the loops unroll and the arrays stay in registers); with `crossing`, also
     /// `(I + D G_AA D) y' = D G_{A,c}` with the same factors, `D y'` into `second_solution[..N]`.
+    #[inline(always)]
     fn solve_active_fixed<const N: usize>(&mut self, crossing: Option<usize>) {
         let stride = self.capacity;
         let mut matrix = [[0.0; N]; N];
@@ -775,6 +859,7 @@ impl ContactStep {
     }
 
     /// The contact damping's loss over the step at the last evaluation, J.
+    #[inline(always)]
     pub fn damping_loss_j(&self) -> f64 {
         let count = self.count;
         self.laws[..count]
