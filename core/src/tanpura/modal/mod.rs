@@ -30,6 +30,7 @@
 //! arrays (f32 for the fast tier, f64 for the plain reference path); the contact solves and all
 //! static problems run in f64.
 
+mod block;
 pub mod lanes;
 pub mod modes;
 pub mod points;
@@ -977,5 +978,47 @@ mod tests {
         );
         assert!(fewest_awake < all_awake, "no point fell asleep");
         assert!(asleep == awake, "sleeping points changed the output");
+    }
+
+    /// The contact solve in fixed lanes (`block.rs`, up to eight tracked points) gives the
+    /// general path's iterates: the same outputs bit for bit (to the sign of a zero) and the
+    /// same Newton updates, through a pluck and a harder second pluck on the bench's tier and
+    /// on a grid fine enough that more than eight points are tracked at times (then both take
+    /// the general path there).
+    #[test]
+    fn fixed_lanes_solve_as_the_general_path() {
+        let run = |spacing_m: f64, general_path_only: bool| {
+            let mut string = ModalString::<f32>::new(ModalStringConfig {
+                bridge_point_spacing_m: spacing_m,
+                thread_point_spacing_m: 0.5 * spacing_m,
+                ..ModalStringConfig::REFERENCE
+            });
+            if general_path_only {
+                string.contact.take_general_path_only();
+            }
+            let (mut output, mut most_tracked) = (Vec::new(), 0);
+            for amplitude_m in [2e-3, 4e-3] {
+                string.pluck(&Pluck {
+                    amplitude_m,
+                    ..Pluck::default()
+                });
+                for _ in 0..44_100 {
+                    string.step();
+                    output.push((string.nut_force_n(), string.bridge_force_n()));
+                    most_tracked = most_tracked.max(string.contact.tracked_count());
+                }
+            }
+            (output, most_tracked, *string.newton_stats())
+        };
+        for spacing_m in [1e-3, 0.25e-3] {
+            let (lanes, most_tracked, lane_stats) = run(spacing_m, false);
+            let (general, _, general_stats) = run(spacing_m, true);
+            assert!(lanes == general, "the paths part at spacing {spacing_m}");
+            assert_eq!(lane_stats, general_stats);
+            assert!(lane_stats.iterations > lane_stats.steps, "{lane_stats:?}");
+            if spacing_m < 1e-3 {
+                assert!(most_tracked > 8, "{most_tracked} points tracked at most");
+            }
+        }
     }
 }

@@ -31,6 +31,7 @@
 //! or twice per sample on the audio thread; the fixed-size LDLᵀ of `solve.rs` is unrolled by the
 //! compiler, and nothing here allocates.
 
+use super::block::{lanes_of, Block, BlockState, BLOCK};
 use super::points::ContactPoints;
 use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
 use crate::newton::NewtonSettings;
@@ -48,6 +49,9 @@ const SLEEP_MARGIN_M: f64 = 10e-6;
 #[derive(Debug, Clone)]
 pub struct ContactStep {
     capacity: usize,
+    /// The length of the per-slot arrays and the block's row stride: `capacity`, at least
+    /// [`BLOCK`], so that the first [`BLOCK`] slots always exist.
+    slot_stride: usize,
     /// a_i per point, m, after every step.
     pub gaps_m: Vec<f64>,
     /// 0 for an awake far point, −∞ for a tracked or a sleeping one: added to a gap, it keeps
@@ -75,7 +79,9 @@ pub struct ContactStep {
     steps: Vec<f64>,
     corrections: Vec<f64>,
     rest_forces: Vec<f64>,
-    laws: Vec<HuntCrossley>,
+    /// The law of each slot, ξ and ψ apart (so that the law runs over the slots in vectors).
+    xis: Vec<f64>,
+    psis: Vec<f64>,
     /// F, c = −∂F/∂Δu and F − F_rest at the last evaluation.
     forces: Vec<f64>,
     stiffnesses: Vec<f64>,
@@ -83,8 +89,13 @@ pub struct ContactStep {
     /// Slots with F ≠ F_rest at the last evaluation.
     loaded: Vec<usize>,
     loaded_count: usize,
-    /// G on the tracked points, `capacity × capacity` with row stride `capacity`.
+    /// G on the tracked points, with row stride `slot_stride`; zero in every row and column of
+    /// a slot past the tracked ones (see [`ContactStep::clear_slot`]).
     block: Vec<f64>,
+    /// Its first [`BLOCK`] rows and columns, for [`ContactStep::solve_block`].
+    block_lanes: Block,
+    /// Whether every solve takes the general path (for the test that the two agree).
+    general_path_only: bool,
     residual: Vec<f64>,
     /// The slots with c > 0 at the last evaluation and their √c.
     active: Vec<usize>,
@@ -160,8 +171,11 @@ impl ContactStep {
     /// Room for `capacity` points. Allocates.
     pub fn new(capacity: usize) -> Self {
         let zeros = || vec![0.0; capacity];
+        let slot_stride = capacity.max(BLOCK);
+        let slot_zeros = || vec![0.0; slot_stride];
         Self {
             capacity,
+            slot_stride,
             gaps_m: zeros(),
             far_offsets_m: zeros(),
             point_free_steps_m: zeros(),
@@ -173,27 +187,30 @@ impl ContactStep {
             slots: vec![UNTRACKED; capacity],
             tracked: vec![0; capacity],
             count: 0,
-            gaps: zeros(),
-            free_steps: zeros(),
-            steps: zeros(),
-            corrections: zeros(),
-            rest_forces: zeros(),
-            laws: vec![HuntCrossley { xi: 0.0, psi: 0.0 }; capacity],
-            forces: zeros(),
-            stiffnesses: zeros(),
-            changes: zeros(),
-            loaded: vec![0; capacity],
+            gaps: slot_zeros(),
+            free_steps: slot_zeros(),
+            steps: slot_zeros(),
+            corrections: slot_zeros(),
+            rest_forces: slot_zeros(),
+            xis: slot_zeros(),
+            psis: slot_zeros(),
+            forces: slot_zeros(),
+            stiffnesses: slot_zeros(),
+            changes: slot_zeros(),
+            loaded: vec![0; slot_stride],
             loaded_count: 0,
-            block: vec![0.0; capacity * capacity],
-            residual: zeros(),
-            active: vec![0; capacity],
-            roots: zeros(),
-            matrix: vec![0.0; capacity * capacity],
-            solution: zeros(),
-            scratch: zeros(),
-            second_solution: zeros(),
-            crossing_direction: zeros(),
-            candidate: zeros(),
+            block: vec![0.0; slot_stride * slot_stride],
+            block_lanes: [[0.0; BLOCK]; BLOCK],
+            general_path_only: false,
+            residual: slot_zeros(),
+            active: vec![0; slot_stride],
+            roots: slot_zeros(),
+            matrix: vec![0.0; slot_stride * slot_stride],
+            solution: slot_zeros(),
+            scratch: slot_zeros(),
+            second_solution: slot_zeros(),
+            crossing_direction: slot_zeros(),
+            candidate: slot_zeros(),
             loaded_points: vec![0; capacity],
             loaded_changes_n: zeros(),
         }
@@ -286,6 +303,17 @@ impl ContactStep {
             self.slots[self.tracked[slot]] = UNTRACKED;
         }
         self.count = 0;
+        for values in [
+            &mut self.gaps,
+            &mut self.free_steps,
+            &mut self.steps,
+            &mut self.corrections,
+            &mut self.rest_forces,
+            &mut self.block,
+        ] {
+            values.fill(0.0);
+        }
+        self.block_lanes = [[0.0; BLOCK]; BLOCK];
         self.awake_count = points.len();
         for i in 0..points.len() {
             self.awake[i] = 1.0;
@@ -323,17 +351,20 @@ impl ContactStep {
         self.steps[slot] = free_step + correction;
         self.corrections[slot] = correction;
         self.rest_forces[slot] = points.rest_forces_n[i];
-        self.laws[slot] = points.laws[i];
+        self.xis[slot] = points.laws[i].xi;
+        self.psis[slot] = points.laws[i].psi;
         self.forces[slot] = points.rest_forces_n[i];
-        let stride = self.capacity;
+        let stride = self.slot_stride;
         for other in 0..=slot {
             let value = points.coupling(i, self.tracked[other]);
             self.block[slot * stride + other] = value;
             self.block[other * stride + slot] = value;
         }
+        self.copy_block_lanes();
     }
 
-    /// Stops tracking the point in `slot`: the last slot moves into it.
+    /// Stops tracking the point in `slot`: the last slot moves into it, and the last slot is
+    /// made neutral.
     fn untrack(&mut self, slot: usize) {
         let i = self.tracked[slot];
         self.slots[i] = UNTRACKED;
@@ -341,26 +372,52 @@ impl ContactStep {
         self.corrections[slot] = 0.0;
         let last = self.count - 1;
         self.count = last;
-        if slot == last {
-            return;
+        if slot != last {
+            let moved = self.tracked[last];
+            self.tracked[slot] = moved;
+            self.slots[moved] = slot;
+            self.gaps[slot] = self.gaps[last];
+            self.free_steps[slot] = self.free_steps[last];
+            self.steps[slot] = self.steps[last];
+            self.corrections[slot] = self.corrections[last];
+            self.rest_forces[slot] = self.rest_forces[last];
+            self.xis[slot] = self.xis[last];
+            self.psis[slot] = self.psis[last];
+            self.forces[slot] = self.forces[last];
+            let stride = self.slot_stride;
+            for other in 0..last {
+                let value = self.block[last * stride + other];
+                self.block[slot * stride + other] = value;
+                self.block[other * stride + slot] = value;
+            }
+            self.block[slot * stride + slot] = self.block[last * stride + last];
         }
-        let moved = self.tracked[last];
-        self.tracked[slot] = moved;
-        self.slots[moved] = slot;
-        self.gaps[slot] = self.gaps[last];
-        self.free_steps[slot] = self.free_steps[last];
-        self.steps[slot] = self.steps[last];
-        self.corrections[slot] = self.corrections[last];
-        self.rest_forces[slot] = self.rest_forces[last];
-        self.laws[slot] = self.laws[last];
-        self.forces[slot] = self.forces[last];
-        let stride = self.capacity;
-        for other in 0..last {
-            let value = self.block[last * stride + other];
-            self.block[slot * stride + other] = value;
-            self.block[other * stride + slot] = value;
+        self.clear_slot(last);
+        self.copy_block_lanes();
+    }
+
+    /// Makes `slot` neutral: no gap, step, correction or rest force, and no coupling with any
+    /// slot. Every slot past the tracked ones is neutral, as [`ContactStep::solve_block`], which
+    /// runs over [`BLOCK`] slots, needs.
+    fn clear_slot(&mut self, slot: usize) {
+        let stride = self.slot_stride;
+        self.gaps[slot] = 0.0;
+        self.free_steps[slot] = 0.0;
+        self.steps[slot] = 0.0;
+        self.corrections[slot] = 0.0;
+        self.rest_forces[slot] = 0.0;
+        self.block[slot * stride..(slot + 1) * stride].fill(0.0);
+        for other in 0..stride {
+            self.block[other * stride + slot] = 0.0;
         }
-        self.block[slot * stride + slot] = self.block[last * stride + last];
+    }
+
+    /// The block's first [`BLOCK`] rows and columns into `block_lanes`.
+    fn copy_block_lanes(&mut self) {
+        let stride = self.slot_stride;
+        for (slot, row) in self.block_lanes.iter_mut().enumerate() {
+            row.copy_from_slice(&self.block[slot * stride..slot * stride + BLOCK]);
+        }
     }
 
     /// One step's contact work on the vector unit of `kernels`: [`ContactStep::solve`], the
@@ -398,12 +455,10 @@ impl ContactStep {
         let mut iterations = 0;
         let mut converged = true;
         loop {
-            if !self.settle_if_free() {
-                let (updates, done) = self.newton(settings);
-                iterations += updates;
+            let (updates, done) = self.solve_tracked(settings);
+            iterations += updates;
+            if let Some(done) = done {
                 converged = done;
-                // The forces at the accepted step, for the update, the outputs and the ledger.
-                self.evaluate();
             }
             if !self.join_touching(points) {
                 break;
@@ -414,6 +469,73 @@ impl ContactStep {
             self.loaded_changes_n[slot] = self.changes[local];
         }
         (iterations, converged)
+    }
+
+    /// The tracked points' forces for the current free steps: none if nothing can touch, else
+    /// Newton's iteration from the current steps and the forces at the accepted step (for the
+    /// update, the outputs and the ledger). Returns the updates and, if Newton ran, whether it
+    /// converged. Up to [`BLOCK`] points, the first update runs in fixed lanes
+    /// ([`ContactStep::solve_block`]).
+    #[inline(always)]
+    fn solve_tracked(&mut self, settings: &NewtonSettings) -> (u32, Option<bool>) {
+        if self.count <= BLOCK && !self.general_path_only {
+            return self.solve_block(settings);
+        }
+        if self.settle_if_free() {
+            return (0, None);
+        }
+        let (updates, done) = self.newton(settings);
+        self.evaluate();
+        (updates, Some(done))
+    }
+
+    /// [`ContactStep::solve_tracked`] on at most [`BLOCK`] points, in fixed lanes (`block.rs`):
+    /// the same iterates (to the sign of a zero).
+    #[inline(always)]
+    fn solve_block(&mut self, settings: &NewtonSettings) -> (u32, Option<bool>) {
+        let count = self.count;
+        let mut block = BlockState {
+            count,
+            gaps: lanes_of(&self.gaps),
+            free_steps: lanes_of(&self.free_steps),
+            steps: lanes_of(&self.steps),
+            rest_forces: lanes_of(&self.rest_forces),
+            xis: lanes_of(&self.xis),
+            psis: lanes_of(&self.psis),
+            forces: [0.0; BLOCK],
+            stiffnesses: [0.0; BLOCK],
+            changes: [0.0; BLOCK],
+        };
+        if block.free_of_contact() {
+            self.loaded_count = 0;
+            self.steps[..count].copy_from_slice(&self.free_steps[..count]);
+            self.forces[..count].fill(0.0);
+            self.changes[..count].fill(0.0);
+            return (0, None);
+        }
+        let (updates, converged) = block.newton(
+            &self.block_lanes,
+            settings.tolerance_m,
+            settings.max_iterations,
+        );
+        self.steps[..BLOCK].copy_from_slice(&block.steps);
+        self.forces[..count].copy_from_slice(&block.forces[..count]);
+        self.stiffnesses[..count].copy_from_slice(&block.stiffnesses[..count]);
+        self.changes[..count].copy_from_slice(&block.changes[..count]);
+        self.loaded_count = 0;
+        for slot in 0..count {
+            if block.changes[slot] != 0.0 {
+                self.loaded[self.loaded_count] = slot;
+                self.loaded_count += 1;
+            }
+        }
+        (updates, Some(converged))
+    }
+
+    /// Makes every solve take the general path, not [`ContactStep::solve_block`] (for tests).
+    #[cfg(test)]
+    pub(super) fn take_general_path_only(&mut self) {
+        self.general_path_only = true;
     }
 
     /// Forms every point's `Σ_j G_ij ΔF_j` at the current forces; a far point whose step
@@ -545,8 +667,11 @@ impl ContactStep {
         let count = self.count;
         self.loaded_count = 0;
         for slot in 0..count {
-            let contact =
-                self.laws[slot].midpoint_force_linear_damping(self.gaps[slot], self.steps[slot]);
+            let law = HuntCrossley {
+                xi: self.xis[slot],
+                psi: self.psis[slot],
+            };
+            let contact = law.midpoint_force_linear_damping(self.gaps[slot], self.steps[slot]);
             self.forces[slot] = contact.force;
             self.stiffnesses[slot] = contact.stiffness;
             let change = contact.force - self.rest_forces[slot];
@@ -641,7 +766,7 @@ impl ContactStep {
     #[inline(always)]
     fn update(&mut self, crossing: Option<usize>) -> (f64, bool) {
         let count = self.count;
-        let stride = self.capacity;
+        let stride = self.slot_stride;
         // R = Δu − Δu_free − G ΔF, with ΔF ≠ 0 only on the loaded points (G is symmetric, so
         // each loaded point adds its row).
         let residual = &mut self.residual[..count];
@@ -731,7 +856,7 @@ impl ContactStep {
     #[inline(always)]
     fn finish_exactly(&mut self, crossing: usize, size: usize) -> Option<f64> {
         let count = self.count;
-        let stride = self.capacity;
+        let stride = self.slot_stride;
         // w = J⁻¹ G e_c = G e_c − G_{:,A} D y', (I + D G_AA D) y' = D G_{A,c}.
         let direction = &mut self.crossing_direction[..count];
         direction.copy_from_slice(&self.block[crossing * stride..crossing * stride + count]);
@@ -745,7 +870,10 @@ impl ContactStep {
         }
         let gap = self.gaps[crossing];
         let start = self.steps[crossing];
-        let law = self.laws[crossing];
+        let law = HuntCrossley {
+            xi: self.xis[crossing],
+            psi: self.psis[crossing],
+        };
         let leaving = gap > 0.0;
         let (p, q, k) = if leaving {
             (law.xi * gap * gap, -2.0 * law.psi * gap, 0.0)
@@ -809,7 +937,7 @@ impl ContactStep {
     /// `(I + D G_AA D) y' = D G_{A,c}` with the same factors, `D y'` into `second_solution[..N]`.
     #[inline(always)]
     fn solve_active_fixed<const N: usize>(&mut self, crossing: Option<usize>) {
-        let stride = self.capacity;
+        let stride = self.slot_stride;
         let mut matrix = [[0.0; N]; N];
         let mut y = [0.0; N];
         for a in 0..N {
@@ -841,7 +969,7 @@ impl ContactStep {
     /// [`ContactStep::solve_active_fixed`] for any size, in the heap buffers. The matrix is SPD
     /// with eigenvalues ≥ 1, so LDLᵀ without pivoting is exact and stable.
     fn solve_active_any(&mut self, size: usize) {
-        let stride = self.capacity;
+        let stride = self.slot_stride;
         let matrix = &mut self.matrix[..size * size];
         for a in 0..size {
             let row = &self.block[self.active[a] * stride..];
@@ -862,11 +990,14 @@ impl ContactStep {
     #[inline(always)]
     pub fn damping_loss_j(&self) -> f64 {
         let count = self.count;
-        self.laws[..count]
-            .iter()
-            .zip(&self.gaps[..count])
-            .zip(&self.steps[..count])
-            .map(|((law, &gap), &step)| law.linear_damping_loss(gap, step))
+        (0..count)
+            .map(|slot| {
+                let law = HuntCrossley {
+                    xi: self.xis[slot],
+                    psi: self.psis[slot],
+                };
+                law.linear_damping_loss(self.gaps[slot], self.steps[slot])
+            })
             .sum()
     }
 }

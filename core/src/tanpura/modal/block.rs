@@ -1,0 +1,390 @@
+//! Newton's iteration of a contact step on at most [`BLOCK`] tracked points, in fixed lanes
+//! (`docs/modal-tanpura.md`, section 4; the equations of `step.rs`, whose general path takes
+//! more points).
+//!
+//! The bridge's crest and the thread rarely hold more than five tracked points.
+//! [`ContactStep`](super::step::ContactStep) loads their state into fixed arrays of [`BLOCK`]
+//! lanes (the slots past the tracked ones are neutral: no gap, no step, no rest force, no
+//! coupling) and iterates here, so that each pass (the law, the residual
+//! `R = Δu − Δu_free − G ΔF`, the update `δ = −R − G_{:,A} D y`, the exact finish's direction
+//! `w = G e_c − G_{:,A} D y'`) is a few full-width vector operations with no loop control, no
+//! bounds checks and no overlap checks between arrays of one struct. Every value is formed by
+//! the arithmetic of the general path in its order, so the iterates agree with it to the last
+//! bit except, at most, in the sign of a zero: a point that adds nothing adds an exact zero
+//! (`x − 0·g`), where the general path skips it.
+//!
+//! Hand-written rather than on a linear-algebra crate for the reasons of `step.rs`.
+
+use super::solve::{ldl_factor_fixed, ldl_substitute_fixed};
+use crate::tanpura::contact::HuntCrossley;
+
+/// The lanes of the fixed path: one AVX-512 register of f64, two AVX2 registers.
+pub const BLOCK: usize = 8;
+/// One value per slot.
+pub type Lanes = [f64; BLOCK];
+/// G on the first [`BLOCK`] slots, row by row.
+pub type Block = [Lanes; BLOCK];
+/// What an update did: the largest component of the applied change (NaN when the state is not
+/// finite) and whether the step is now exact.
+type Update = (f64, bool);
+
+/// The tracked points' state in slot order; the lanes from `count` on are neutral.
+#[derive(Debug, Clone, Copy)]
+pub struct BlockState {
+    pub count: usize,
+    pub gaps: Lanes,
+    pub free_steps: Lanes,
+    pub steps: Lanes,
+    pub rest_forces: Lanes,
+    pub xis: Lanes,
+    pub psis: Lanes,
+    /// F, c = −∂F/∂Δu and F − F_rest at the last evaluation.
+    pub forces: Lanes,
+    pub stiffnesses: Lanes,
+    pub changes: Lanes,
+}
+
+/// `values` as lanes (`values` holds at least [`BLOCK`] elements).
+#[inline(always)]
+pub fn lanes_of(values: &[f64]) -> Lanes {
+    let mut lanes = [0.0; BLOCK];
+    lanes.copy_from_slice(&values[..BLOCK]);
+    lanes
+}
+
+/// Whether a point is in contact before and after a step `step` from gap `gap`.
+#[inline(always)]
+fn contact_case(gap: f64, step: f64) -> (bool, bool) {
+    (gap > 0.0, gap - step > 0.0)
+}
+
+impl BlockState {
+    /// Whether no point can exert a force different from its rest force during the free step
+    /// (`ContactStep::settle_if_free`'s test).
+    #[inline(always)]
+    pub fn free_of_contact(&self) -> bool {
+        let mut free = true;
+        for lane in 0..BLOCK {
+            let gap = self.gaps[lane];
+            free &=
+                self.rest_forces[lane] == 0.0 && gap <= 0.0 && gap - self.free_steps[lane] <= 0.0;
+        }
+        free
+    }
+
+    /// Whether some point enters or leaves contact during its current step.
+    #[inline(always)]
+    pub fn crosses(&self) -> bool {
+        let mut crossing = false;
+        for lane in 0..BLOCK {
+            let (before, after) = contact_case(self.gaps[lane], self.steps[lane]);
+            crossing |= before != after;
+        }
+        crossing
+    }
+
+    /// The law at the current steps when no point crosses: every point either stays in contact
+    /// (the law's linear branch) or out of it, bit for bit
+    /// [`HuntCrossley::midpoint_force_linear_damping`] in those cases.
+    #[inline(always)]
+    pub fn evaluate_without_crossing(&mut self) {
+        for lane in 0..BLOCK {
+            let (gap, step) = (self.gaps[lane], self.steps[lane]);
+            let damping = 2.0 * self.psis[lane] * gap.max(0.0);
+            let touching = gap > 0.0;
+            let force = self.xis[lane] * (2.0 * gap - step) - damping * step;
+            self.forces[lane] = if touching { force } else { 0.0 };
+            self.stiffnesses[lane] = if touching {
+                self.xis[lane] + damping
+            } else {
+                0.0
+            };
+            self.changes[lane] = self.forces[lane] - self.rest_forces[lane];
+        }
+    }
+
+    /// The law at the current steps, point by point where some point crosses.
+    #[inline(always)]
+    pub fn evaluate(&mut self) {
+        if !self.crosses() {
+            self.evaluate_without_crossing();
+            return;
+        }
+        for lane in 0..self.count {
+            let law = HuntCrossley {
+                xi: self.xis[lane],
+                psi: self.psis[lane],
+            };
+            let contact = law.midpoint_force_linear_damping(self.gaps[lane], self.steps[lane]);
+            self.forces[lane] = contact.force;
+            self.stiffnesses[lane] = contact.stiffness;
+            self.changes[lane] = contact.force - self.rest_forces[lane];
+        }
+    }
+
+    /// Whether every point is in the same contact case before and after its step.
+    #[inline(always)]
+    pub fn cases_unchanged(&self) -> bool {
+        !self.crosses()
+    }
+
+    /// How many points enter or leave contact during their step, and the slot of the last.
+    #[inline(always)]
+    fn crossing_points(&self) -> (usize, usize) {
+        let mut count = 0;
+        for lane in 0..BLOCK {
+            let (before, after) = contact_case(self.gaps[lane], self.steps[lane]);
+            count += usize::from(before != after);
+        }
+        let mut last = 0;
+        if count == 1 {
+            for slot in 0..self.count {
+                let (before, after) = contact_case(self.gaps[slot], self.steps[slot]);
+                if before != after {
+                    last = slot;
+                }
+            }
+        }
+        (count, last)
+    }
+
+    /// Newton's iteration from the current steps, at most `max_iterations` updates, stopping
+    /// as `ContactStep::newton` does; then the forces at the accepted step. Returns (updates,
+    /// converged).
+    #[inline(always)]
+    pub fn newton(&mut self, block: &Block, tolerance_m: f64, max_iterations: u32) -> (u32, bool) {
+        let cap = max_iterations.max(1);
+        let mut outcome = (cap, false);
+        for iteration in 1..=cap {
+            self.evaluate();
+            let (crossing, crossing_slot) = self.crossing_points();
+            let linear = crossing == 0;
+            let (largest, exact) = self.update(block, (crossing == 1).then_some(crossing_slot));
+            if !largest.is_finite() {
+                outcome = (iteration, false);
+                break;
+            }
+            // Exact: the update solved the step for the cases of the evaluation point, and the
+            // step lies in those cases (always so when the law was linear at the evaluation
+            // point and the cases did not change).
+            if exact || largest <= tolerance_m || (linear && self.cases_unchanged()) {
+                outcome = (iteration, true);
+                break;
+            }
+        }
+        self.evaluate();
+        outcome
+    }
+
+    /// One Newton update `δ = −J⁻¹ R` at the last evaluation, applied to the steps; with
+    /// `crossing` (the one point that enters or leaves contact), first the step solved exactly
+    /// for the evaluation point's contact cases, taken if it lies in them
+    /// (`ContactStep::update`).
+    #[inline(always)]
+    fn update(&mut self, block: &Block, crossing: Option<usize>) -> Update {
+        // R = Δu − Δu_free − G ΔF; a point with no force change adds an exact zero.
+        let mut residual = [0.0; BLOCK];
+        for lane in 0..BLOCK {
+            residual[lane] = self.steps[lane] - self.free_steps[lane];
+        }
+        for (row, &change) in block.iter().zip(&self.changes) {
+            for lane in 0..BLOCK {
+                residual[lane] -= row[lane] * change;
+            }
+        }
+        // A: the points with c > 0, and D = diag(√c) on them.
+        let mut active = [0usize; BLOCK];
+        let mut roots = [0.0; BLOCK];
+        let mut size = 0;
+        for slot in 0..self.count {
+            if self.stiffnesses[slot] > 0.0 {
+                active[size] = slot;
+                roots[size] = self.stiffnesses[slot].sqrt();
+                size += 1;
+            }
+        }
+        // (I + D G_AA D) y = −D R_A and D y per point (zero off A); with a crossing point c,
+        // also (I + D G_AA D) y' = D G_{A,c} and D y'.
+        let system = Active {
+            block,
+            active: &active,
+            roots: &roots,
+            crossing,
+        };
+        let mut weights = [0.0; BLOCK];
+        let mut crossing_weights = [0.0; BLOCK];
+        let finite = match size {
+            0 => true,
+            1 => system.solve::<1>(&residual, &mut weights, &mut crossing_weights),
+            2 => system.solve::<2>(&residual, &mut weights, &mut crossing_weights),
+            3 => system.solve::<3>(&residual, &mut weights, &mut crossing_weights),
+            4 => system.solve::<4>(&residual, &mut weights, &mut crossing_weights),
+            5 => system.solve::<5>(&residual, &mut weights, &mut crossing_weights),
+            6 => system.solve::<6>(&residual, &mut weights, &mut crossing_weights),
+            7 => system.solve::<7>(&residual, &mut weights, &mut crossing_weights),
+            _ => system.solve::<8>(&residual, &mut weights, &mut crossing_weights),
+        };
+        // δ = −R − G_{:,A} D y.
+        let mut deltas = [0.0; BLOCK];
+        for lane in 0..BLOCK {
+            deltas[lane] = -residual[lane];
+        }
+        for (row, &weight) in block.iter().zip(&weights) {
+            for lane in 0..BLOCK {
+                deltas[lane] -= row[lane] * weight;
+            }
+        }
+        if let Some(crossing) = crossing {
+            if let Some(largest) = self.finish_exactly(block, crossing, &deltas, &crossing_weights)
+            {
+                return (largest, true);
+            }
+        }
+        let mut largest = 0.0f64;
+        for lane in 0..BLOCK {
+            self.steps[lane] += deltas[lane];
+            largest = largest.max(deltas[lane].abs());
+        }
+        if finite && largest.is_finite() {
+            (largest, false)
+        } else {
+            (f64::NAN, false)
+        }
+    }
+
+    /// The step solved exactly for the contact cases of the evaluation point when one point `c`
+    /// crosses and every other stays in or out (`ContactStep::finish_exactly`, derived in
+    /// `docs/modal-tanpura.md`, section 4): with the update `deltas` and `w = J⁻¹ G e_c`, the
+    /// crossing point's own equation is a quadratic in its step. Replaces the steps and returns
+    /// the largest change if every point then lies in the case it was evaluated in.
+    #[inline(always)]
+    fn finish_exactly(
+        &mut self,
+        block: &Block,
+        crossing: usize,
+        deltas: &Lanes,
+        crossing_weights: &Lanes,
+    ) -> Option<f64> {
+        // w = G e_c − G_{:,A} D y'.
+        let mut direction = block[crossing];
+        for (row, &weight) in block.iter().zip(crossing_weights) {
+            for lane in 0..BLOCK {
+                direction[lane] -= row[lane] * weight;
+            }
+        }
+        let gap = self.gaps[crossing];
+        let start = self.steps[crossing];
+        let (xi, psi) = (self.xis[crossing], self.psis[crossing]);
+        let leaving = gap > 0.0;
+        let (p, q, k) = if leaving {
+            (xi * gap * gap, -2.0 * psi * gap, 0.0)
+        } else {
+            (-xi * gap * gap, -xi, 2.0 * xi * gap)
+        };
+        let (force, stiffness) = (self.forces[crossing], self.stiffnesses[crossing]);
+        let w = direction[crossing];
+        let newton = start + deltas[crossing];
+        // s − s⁰ − δ_c − w ρ(s) = 0, times s: α s² − β s − γ = 0.
+        let alpha = 1.0 - w * (q + stiffness);
+        let beta = newton + w * (k - force - stiffness * start);
+        let gamma = w * p;
+        let discriminant = beta * beta + 4.0 * alpha * gamma;
+        // Also false for a NaN discriminant.
+        let real_roots = discriminant >= 0.0;
+        if !real_roots || alpha == 0.0 {
+            return None;
+        }
+        let half = 0.5 * (beta + beta.signum() * discriminant.sqrt());
+        if half == 0.0 {
+            return None;
+        }
+        let in_case = |s: f64| {
+            let (before, after) = contact_case(gap, s);
+            before == leaving && after != leaving && s != 0.0
+        };
+        let step = match (half / alpha, -gamma / half) {
+            (one, other) if in_case(one) && in_case(other) => {
+                if (one - newton).abs() <= (other - newton).abs() {
+                    one
+                } else {
+                    other
+                }
+            }
+            (one, _) if in_case(one) => one,
+            (_, other) if in_case(other) => other,
+            _ => return None,
+        };
+        let departure = (p / step + q * step + k) - force + stiffness * (step - start);
+        let mut candidates = self.steps;
+        let mut largest = 0.0f64;
+        for slot in 0..self.count {
+            let candidate = if slot == crossing {
+                step
+            } else {
+                self.steps[slot] + deltas[slot] + departure * direction[slot]
+            };
+            let evaluated = contact_case(self.gaps[slot], self.steps[slot]);
+            if !candidate.is_finite() || contact_case(self.gaps[slot], candidate) != evaluated {
+                return None;
+            }
+            candidates[slot] = candidate;
+            largest = largest.max((candidate - self.steps[slot]).abs());
+        }
+        self.steps = candidates;
+        Some(largest)
+    }
+}
+
+/// The linear system of an update on the active points `A`: `I + D G_AA D`.
+struct Active<'a> {
+    block: &'a Block,
+    active: &'a [usize; BLOCK],
+    roots: &'a Lanes,
+    crossing: Option<usize>,
+}
+
+impl Active<'_> {
+    /// `(I + D G_AA D) y = −D R_A` for the `N` active points: writes `D y` into `weights` at
+    /// the points' lanes and, with a crossing point c, `D y'` for `(I + D G_AA D) y' = D G_{A,c}`
+    /// into `crossing_weights`; returns whether `D y` is finite
+    /// (`ContactStep::solve_active_fixed`).
+    #[inline(always)]
+    fn solve<const N: usize>(
+        &self,
+        residual: &Lanes,
+        weights: &mut Lanes,
+        crossing_weights: &mut Lanes,
+    ) -> bool {
+        let (block, active, roots) = (self.block, self.active, self.roots);
+        let mut matrix = [[0.0; N]; N];
+        let mut y = [0.0; N];
+        for a in 0..N {
+            let row = &block[active[a]];
+            for b in 0..=a {
+                matrix[a][b] = roots[a] * row[active[b]] * roots[b];
+            }
+            matrix[a][a] += 1.0;
+            y[a] = -roots[a] * residual[active[a]];
+        }
+        ldl_factor_fixed(&mut matrix);
+        ldl_substitute_fixed(&matrix, &mut y);
+        let mut finite = true;
+        for a in 0..N {
+            let weight = y[a] * roots[a];
+            weights[active[a]] = weight;
+            finite &= weight.is_finite();
+        }
+        if let Some(crossing) = self.crossing {
+            let column = &block[crossing];
+            let mut second = [0.0; N];
+            for a in 0..N {
+                second[a] = roots[a] * column[active[a]];
+            }
+            ldl_substitute_fixed(&matrix, &mut second);
+            for a in 0..N {
+                crossing_weights[active[a]] = second[a] * roots[a];
+            }
+        }
+        finite
+    }
+}
