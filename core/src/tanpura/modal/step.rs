@@ -67,6 +67,11 @@ pub struct ContactStep {
     awake_free_steps_m: Vec<f64>,
     /// This step's `Σ_j G_ij ΔF_j` per point, m.
     coupled_m: Vec<f64>,
+    /// Every point's gap after the step at the last forces (the tracked points' are replaced
+    /// by Newton's), formed with the test for far points that would touch; and whether a far
+    /// point then lies within the tracking band.
+    next_gaps_m: Vec<f64>,
+    far_point_near: bool,
     /// Each point's slot among the tracked, or [`UNTRACKED`].
     slots: Vec<usize>,
     /// The tracked points (point indices), in slot order.
@@ -144,7 +149,7 @@ impl WithSimd for ContactPass<'_> {
     #[inline(always)]
     fn with_simd<S: Simd>(self, _simd: S) -> ContactOutcome {
         let contact = self.contact;
-        let (iterations, converged) = contact.solve(self.points, self.settings);
+        let (iterations, converged) = contact.solve(self.points, self.settings, self.band_m);
         let damping_loss_j = if self.track_energy {
             contact.damping_loss_j()
         } else {
@@ -158,6 +163,55 @@ impl WithSimd for ContactPass<'_> {
             damping_loss_j,
             penetration_m,
         }
+    }
+}
+
+/// The per-point arrays of [`far_points_after_step`].
+struct FarPoints<'a> {
+    gaps_m: &'a [f64],
+    /// 0 for an awake far point, −∞ for a tracked or a sleeping one.
+    offsets_m: &'a [f64],
+    free_steps_m: &'a [f64],
+    coupled_m: &'a [f64],
+    /// 1 for an awake point, 0 for a sleeping one.
+    awake: &'a [f64],
+}
+
+/// Every point's gap after the step, `a − (Ψ_i s_free + Σ_j G_ij ΔF_j)` (a sleeping point's
+/// frozen), into `next_gaps_m`, in one pass with the two tests on far points: whether one would
+/// touch during the step, and whether one then lies within `band_m` of contact.
+#[inline(always)]
+fn far_points_after_step(far: FarPoints, next_gaps_m: &mut [f64], band_m: f64) -> (bool, bool) {
+    let (mut touches, mut near) = (false, false);
+    let inputs = far
+        .gaps_m
+        .iter()
+        .zip(far.offsets_m)
+        .zip(far.free_steps_m.iter().zip(far.coupled_m).zip(far.awake));
+    for (next, ((&gap, &offset), ((&free_step, &coupled), &awake))) in
+        next_gaps_m.iter_mut().zip(inputs)
+    {
+        let step = free_step + coupled;
+        touches |= (gap + offset) - step > 0.0;
+        *next = gap - step * awake;
+        near |= *next + offset > -band_m;
+    }
+    (touches, near)
+}
+
+/// `target[i] = row[i] · scale`.
+#[inline(always)]
+fn scaled(target: &mut [f64], row: &[f64], scale: f64) {
+    for (t, &g) in target.iter_mut().zip(row) {
+        *t = g * scale;
+    }
+}
+
+/// `target[i] += row[i] · scale`.
+#[inline(always)]
+fn add_scaled(target: &mut [f64], row: &[f64], scale: f64) {
+    for (t, &g) in target.iter_mut().zip(row) {
+        *t += g * scale;
     }
 }
 
@@ -184,6 +238,8 @@ impl ContactStep {
             awake_count: 0,
             awake_free_steps_m: zeros(),
             coupled_m: zeros(),
+            next_gaps_m: zeros(),
+            far_point_near: false,
             slots: vec![UNTRACKED; capacity],
             tracked: vec![0; capacity],
             count: 0,
@@ -446,7 +502,12 @@ impl ContactStep {
     /// [`ContactStep::point_free_steps_mut`]). A far point that would touch during the step joins and the
     /// solve is redone. Returns (Newton updates, converged).
     #[inline(always)]
-    pub fn solve(&mut self, points: &ContactPoints, settings: &NewtonSettings) -> (u32, bool) {
+    pub fn solve(
+        &mut self,
+        points: &ContactPoints,
+        settings: &NewtonSettings,
+        band_m: f64,
+    ) -> (u32, bool) {
         for slot in 0..self.count {
             let free_step = self.point_free_steps_m[self.tracked[slot]];
             self.free_steps[slot] = free_step;
@@ -460,7 +521,7 @@ impl ContactStep {
             if let Some(done) = done {
                 converged = done;
             }
-            if !self.join_touching(points) {
+            if !self.join_touching(points, band_m) {
                 break;
             }
         }
@@ -542,7 +603,7 @@ impl ContactStep {
     /// `Ψ_i s_free + Σ_j G_ij ΔF_j` would bring it into contact joins (returns true: the solve
     /// must be redone).
     #[inline(always)]
-    fn join_touching(&mut self, points: &ContactPoints) -> bool {
+    fn join_touching(&mut self, points: &ContactPoints, band_m: f64) -> bool {
         let count = points.len();
         let stride = self.capacity;
         // Σ_j G_ij ΔF_j for every point, a row of G (= its column) per loaded point.
@@ -553,30 +614,33 @@ impl ContactStep {
             None => coupled.fill(0.0),
             Some((&first, rest)) => {
                 let row = self.tracked[first] * stride;
-                let change = self.changes[first];
-                for (sum, g) in coupled.iter_mut().zip(&points.coupling[row..row + count]) {
-                    *sum = g * change;
-                }
+                scaled(
+                    coupled,
+                    &points.coupling[row..row + count],
+                    self.changes[first],
+                );
                 for &local in rest {
                     let row = self.tracked[local] * stride;
-                    let change = self.changes[local];
-                    for (sum, g) in coupled.iter_mut().zip(&points.coupling[row..row + count]) {
-                        *sum += g * change;
-                    }
+                    add_scaled(
+                        coupled,
+                        &points.coupling[row..row + count],
+                        self.changes[local],
+                    );
                 }
             }
         }
-        let mut touches = false;
-        let far_gaps = self.gaps_m[..count]
-            .iter()
-            .zip(&self.far_offsets_m[..count]);
-        for ((&gap, &offset), (&free_step, &coupled)) in far_gaps.zip(
-            self.point_free_steps_m[..count]
-                .iter()
-                .zip(&self.coupled_m[..count]),
-        ) {
-            touches |= (gap + offset) - (free_step + coupled) > 0.0;
-        }
+        let (touches, near) = far_points_after_step(
+            FarPoints {
+                gaps_m: &self.gaps_m[..count],
+                offsets_m: &self.far_offsets_m[..count],
+                free_steps_m: &self.point_free_steps_m[..count],
+                coupled_m: &self.coupled_m[..count],
+                awake: &self.awake[..count],
+            },
+            &mut self.next_gaps_m[..count],
+            band_m,
+        );
+        self.far_point_near = near;
         if !touches {
             return false;
         }
@@ -606,15 +670,10 @@ impl ContactStep {
     /// the tracked points after the step (0 if none), m.
     #[inline(always)]
     pub fn finish_step(&mut self, points: &ContactPoints) -> f64 {
-        let count = points.len();
-        // Every point by its step at the converged forces; the tracked ones by Newton's below.
-        for ((gap, &free_step), (&coupled, &awake)) in self.gaps_m[..count]
-            .iter_mut()
-            .zip(&self.point_free_steps_m[..count])
-            .zip(self.coupled_m[..count].iter().zip(&self.awake[..count]))
-        {
-            *gap -= (free_step + coupled) * awake;
-        }
+        // Every point by its step at the converged forces (formed by the last
+        // `join_touching`); the tracked ones by Newton's below.
+        debug_assert!(points.len() <= self.next_gaps_m.len());
+        std::mem::swap(&mut self.gaps_m, &mut self.next_gaps_m);
         let mut penetration = 0.0f64;
         for slot in 0..self.count {
             let gap = self.gaps[slot] - self.steps[slot];
@@ -641,17 +700,12 @@ impl ContactStep {
                 slot += 1;
             }
         }
-        let count = points.len();
-        let mut near = false;
-        for (&gap, &offset) in self.gaps_m[..count]
-            .iter()
-            .zip(&self.far_offsets_m[..count])
-        {
-            near |= gap + offset > -band_m;
-        }
-        if !near {
+        // Whether a far point lies within the band, as the last `join_touching` found (a point
+        // released above lies farther than `release_m` ≥ `band_m`, so it is not near).
+        if !self.far_point_near {
             return;
         }
+        let count = points.len();
         for i in 0..count {
             let gap = self.gaps_m[i];
             if gap + self.far_offsets_m[i] > -band_m {
