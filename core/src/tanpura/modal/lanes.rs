@@ -214,8 +214,9 @@ fn one_dot<T: Real, S: Simd>(simd: S, x: &[T::Lanes<S>], row: &[T::Lanes<S>]) ->
     T::sum(simd, T::add(simd, sums[0], sums[1])).to_f64()
 }
 
-/// Dot products of several rows of a matrix with one vector: `out[j] = matrix[rows[j]] · x`.
-struct Dots<'a, T: Real> {
+/// Dot products of several rows of a matrix with one vector: `out[j] = matrix[rows[j]] · x`,
+/// or with `SCATTER`, `out[rows[j]] = matrix[rows[j]] · x`.
+struct Dots<'a, T: Real, const SCATTER: bool> {
     matrix: &'a [T],
     stride: usize,
     rows: &'a [usize],
@@ -223,7 +224,7 @@ struct Dots<'a, T: Real> {
     out: &'a mut [f64],
 }
 
-impl<T: Real> WithSimd for Dots<'_, T> {
+impl<T: Real, const SCATTER: bool> WithSimd for Dots<'_, T, SCATTER> {
     type Output = ();
 
     #[inline(always)]
@@ -234,6 +235,26 @@ impl<T: Real> WithSimd for Dots<'_, T> {
             let start = index * self.stride;
             T::lanes::<S>(&self.matrix[start..start + length])
         };
+        if SCATTER {
+            let out = self.out;
+            let mut rows = self.rows.chunks_exact(4);
+            for indices in &mut rows {
+                let rows = [
+                    row(indices[0]),
+                    row(indices[1]),
+                    row(indices[2]),
+                    row(indices[3]),
+                ];
+                let sums = four_dots::<T, S>(simd, x, rows);
+                for (&index, sum) in indices.iter().zip(sums) {
+                    out[index] = sum;
+                }
+            }
+            for &index in rows.remainder() {
+                out[index] = one_dot::<T, S>(simd, x, row(index));
+            }
+            return;
+        }
         let mut rows = self.rows.chunks_exact(4);
         let mut outputs = self.out.chunks_exact_mut(4);
         for (indices, out) in (&mut rows).zip(&mut outputs) {
@@ -498,7 +519,27 @@ impl Kernels {
         out: &mut [f64],
     ) {
         debug_assert!(out.len() >= rows.len() && x.len() <= stride);
-        self.arch.dispatch(Dots {
+        self.arch.dispatch(Dots::<T, false> {
+            matrix,
+            stride,
+            rows,
+            x,
+            out,
+        });
+    }
+
+    /// `out[rows[j]] = matrix[rows[j]] · x` for every listed row: [`Kernels::dots`] with each
+    /// sum written at its row's index, bit for bit.
+    pub fn scattered_dots<T: Real>(
+        &self,
+        matrix: &[T],
+        stride: usize,
+        rows: &[usize],
+        x: &[T],
+        out: &mut [f64],
+    ) {
+        debug_assert!(rows.iter().all(|&row| row < out.len()) && x.len() <= stride);
+        self.arch.dispatch(Dots::<T, true> {
             matrix,
             stride,
             rows,

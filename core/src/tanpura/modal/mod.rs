@@ -469,14 +469,13 @@ impl<T: Real> ModalString<T> {
                 .leading_dots(&self.shapes, MODE_CAPACITY, &self.step[..lanes], free_steps);
         } else {
             let (rows, free_steps) = self.contact.awake_rows();
-            self.kernels.dots(
+            self.kernels.scattered_dots(
                 &self.shapes,
                 MODE_CAPACITY,
                 rows,
                 &self.step[..lanes],
                 free_steps,
             );
-            self.contact.spread_awake_free_steps();
         }
         // The contact solve, and the tracking for the next step (which reads only the gaps and
         // forces, not the modes).

@@ -59,12 +59,11 @@ pub struct ContactStep {
     far_offsets_m: Vec<f64>,
     /// `Ψ_i s_free` per point, m.
     point_free_steps_m: Vec<f64>,
-    /// 1 for an awake point, 0 for a sleeping one (see [`ContactStep::sleep_far_points`]); the
-    /// awake points in order, and their free steps as the kernel writes them.
+    /// 1 for an awake point, 0 for a sleeping one (see [`ContactStep::sleep_far_points`]), and
+    /// the awake points in order.
     awake: Vec<f64>,
     awake_points: Vec<usize>,
     awake_count: usize,
-    awake_free_steps_m: Vec<f64>,
     /// This step's `Σ_j G_ij ΔF_j` per point, m.
     coupled_m: Vec<f64>,
     /// Every point's gap after the step at the last forces (the tracked points' are replaced
@@ -236,7 +235,6 @@ impl ContactStep {
             awake: vec![1.0; capacity],
             awake_points: (0..capacity).collect(),
             awake_count: 0,
-            awake_free_steps_m: zeros(),
             coupled_m: zeros(),
             next_gaps_m: zeros(),
             far_point_near: false,
@@ -278,24 +276,13 @@ impl ContactStep {
         (self.awake_count == count).then_some(&mut self.point_free_steps_m[..count])
     }
 
-    /// The awake points, and where their free steps go in that order (then
-    /// [`ContactStep::spread_awake_free_steps`]).
+    /// The awake points, and the free steps by point, where the awake points' go (the sleeping
+    /// points' stay 0).
     pub fn awake_rows(&mut self) -> (&[usize], &mut [f64]) {
-        let count = self.awake_count;
         (
-            &self.awake_points[..count],
-            &mut self.awake_free_steps_m[..count],
+            &self.awake_points[..self.awake_count],
+            &mut self.point_free_steps_m,
         )
-    }
-
-    /// Puts the awake points' free steps in their places (the sleeping points' stay 0).
-    pub fn spread_awake_free_steps(&mut self) {
-        for (&i, &step) in self.awake_points[..self.awake_count]
-            .iter()
-            .zip(&self.awake_free_steps_m)
-        {
-            self.point_free_steps_m[i] = step;
-        }
     }
 
     /// How many points are awake.
