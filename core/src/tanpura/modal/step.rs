@@ -27,6 +27,10 @@
 //! would, it joins and the solve is redone before anything moves, so the solve is exact for every
 //! point.
 //!
+//! Up to eight tracked points (nearly every step), the iteration runs in fixed lanes
+//! (`block.rs`), the same iterates bit for bit; the whole contact work of a step is one function
+//! compiled for the machine's vector unit ([`ContactStep::step`]).
+//!
 //! Hand-written rather than on a linear-algebra crate: the systems are 1–12 points, solved once
 //! or twice per sample on the audio thread; the fixed-size LDLᵀ of `solve.rs` is unrolled by the
 //! compiler, and nothing here allocates.
