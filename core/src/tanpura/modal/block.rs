@@ -54,8 +54,78 @@ pub fn lanes_of(values: &[f64]) -> Lanes {
 
 /// Whether a point is in contact before and after a step `step` from gap `gap`.
 #[inline(always)]
-fn contact_case(gap: f64, step: f64) -> (bool, bool) {
+pub fn contact_case(gap: f64, step: f64) -> (bool, bool) {
     (gap > 0.0, gap - step > 0.0)
+}
+
+/// The crossing point c of the exact finish (`docs/modal-tanpura.md`, section 4): its gap
+/// before the step, its step `s⁰` at the evaluation point, its law and the law's force and `c`
+/// there, `w_c` of the direction `w = J⁻¹ G e_c`, and Newton's update `δ_c`.
+pub struct CrossingPoint {
+    pub gap: f64,
+    pub start: f64,
+    pub law: HuntCrossley,
+    pub force: f64,
+    pub stiffness: f64,
+    pub direction: f64,
+    pub delta: f64,
+}
+
+/// The crossing point's own equation `s = s⁰ + δ_c + w_c ρ(s)`, where `ρ(s) = F_c(s) − F_c⁰ +
+/// c_c (s − s⁰)` and, on a crossing, `F_c(s) = P/s + Q s + K` (leaving: `P = ξa²`, `Q = −2ψa`,
+/// `K = 0`; entering: `P = −ξa²`, `Q = −ξ`, `K = 2ξa`), times s: a quadratic. Returns its root
+/// in the crossing case (the one nearer Newton's `s⁰ + δ_c` if both are) and `ρ` there, or
+/// `None` if it has none. Both paths of the solve (`block.rs`, `step.rs`) finish with it.
+#[inline(always)]
+pub fn exact_crossing_step(point: CrossingPoint) -> Option<(f64, f64)> {
+    let CrossingPoint {
+        gap,
+        start,
+        law,
+        force,
+        stiffness,
+        direction: w,
+        delta,
+    } = point;
+    let leaving = gap > 0.0;
+    let (p, q, k) = if leaving {
+        (law.xi * gap * gap, -2.0 * law.psi * gap, 0.0)
+    } else {
+        (-law.xi * gap * gap, -law.xi, 2.0 * law.xi * gap)
+    };
+    let newton = start + delta;
+    // s − s⁰ − δ_c − w ρ(s) = 0, times s: α s² − β s − γ = 0.
+    let alpha = 1.0 - w * (q + stiffness);
+    let beta = newton + w * (k - force - stiffness * start);
+    let gamma = w * p;
+    let discriminant = beta * beta + 4.0 * alpha * gamma;
+    // Also false for a NaN discriminant.
+    let real_roots = discriminant >= 0.0;
+    if !real_roots || alpha == 0.0 {
+        return None;
+    }
+    let half = 0.5 * (beta + beta.signum() * discriminant.sqrt());
+    if half == 0.0 {
+        return None;
+    }
+    let in_case = |s: f64| {
+        let (before, after) = contact_case(gap, s);
+        before == leaving && after != leaving && s != 0.0
+    };
+    let step = match (half / alpha, -gamma / half) {
+        (one, other) if in_case(one) && in_case(other) => {
+            if (one - newton).abs() <= (other - newton).abs() {
+                one
+            } else {
+                other
+            }
+        }
+        (one, _) if in_case(one) => one,
+        (_, other) if in_case(other) => other,
+        _ => return None,
+    };
+    let departure = (p / step + q * step + k) - force + stiffness * (step - start);
+    Some((step, departure))
 }
 
 impl BlockState {
@@ -273,48 +343,18 @@ impl BlockState {
             }
         }
         let gap = self.gaps[crossing];
-        let start = self.steps[crossing];
-        let (xi, psi) = (self.xis[crossing], self.psis[crossing]);
-        let leaving = gap > 0.0;
-        let (p, q, k) = if leaving {
-            (xi * gap * gap, -2.0 * psi * gap, 0.0)
-        } else {
-            (-xi * gap * gap, -xi, 2.0 * xi * gap)
-        };
-        let (force, stiffness) = (self.forces[crossing], self.stiffnesses[crossing]);
-        let w = direction[crossing];
-        let newton = start + deltas[crossing];
-        // s − s⁰ − δ_c − w ρ(s) = 0, times s: α s² − β s − γ = 0.
-        let alpha = 1.0 - w * (q + stiffness);
-        let beta = newton + w * (k - force - stiffness * start);
-        let gamma = w * p;
-        let discriminant = beta * beta + 4.0 * alpha * gamma;
-        // Also false for a NaN discriminant.
-        let real_roots = discriminant >= 0.0;
-        if !real_roots || alpha == 0.0 {
-            return None;
-        }
-        let half = 0.5 * (beta + beta.signum() * discriminant.sqrt());
-        if half == 0.0 {
-            return None;
-        }
-        let in_case = |s: f64| {
-            let (before, after) = contact_case(gap, s);
-            before == leaving && after != leaving && s != 0.0
-        };
-        let step = match (half / alpha, -gamma / half) {
-            (one, other) if in_case(one) && in_case(other) => {
-                if (one - newton).abs() <= (other - newton).abs() {
-                    one
-                } else {
-                    other
-                }
-            }
-            (one, _) if in_case(one) => one,
-            (_, other) if in_case(other) => other,
-            _ => return None,
-        };
-        let departure = (p / step + q * step + k) - force + stiffness * (step - start);
+        let (step, departure) = exact_crossing_step(CrossingPoint {
+            gap,
+            start: self.steps[crossing],
+            law: HuntCrossley {
+                xi: self.xis[crossing],
+                psi: self.psis[crossing],
+            },
+            force: self.forces[crossing],
+            stiffness: self.stiffnesses[crossing],
+            direction: direction[crossing],
+            delta: deltas[crossing],
+        })?;
         let mut candidates = self.steps;
         let mut largest = 0.0f64;
         for slot in 0..self.count {

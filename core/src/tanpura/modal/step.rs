@@ -35,7 +35,9 @@
 //! or twice per sample on the audio thread; the fixed-size LDLᵀ of `solve.rs` is unrolled by the
 //! compiler, and nothing here allocates.
 
-use super::block::{lanes_of, Block, BlockState, BLOCK};
+use super::block::{
+    contact_case, exact_crossing_step, lanes_of, Block, BlockState, CrossingPoint, BLOCK,
+};
 use super::points::ContactPoints;
 use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
 use crate::newton::NewtonSettings;
@@ -216,12 +218,6 @@ fn add_scaled(target: &mut [f64], row: &[f64], scale: f64) {
     for (t, &g) in target.iter_mut().zip(row) {
         *t += g * scale;
     }
-}
-
-/// Whether a point is in contact before and after a step `step` from gap `gap`.
-#[inline]
-fn contact_case(gap: f64, step: f64) -> (bool, bool) {
-    (gap > 0.0, gap - step > 0.0)
 }
 
 impl ContactStep {
@@ -913,52 +909,18 @@ impl ContactStep {
                 *w -= g * weight;
             }
         }
-        let gap = self.gaps[crossing];
-        let start = self.steps[crossing];
-        let law = HuntCrossley {
-            xi: self.xis[crossing],
-            psi: self.psis[crossing],
-        };
-        let leaving = gap > 0.0;
-        let (p, q, k) = if leaving {
-            (law.xi * gap * gap, -2.0 * law.psi * gap, 0.0)
-        } else {
-            (-law.xi * gap * gap, -law.xi, 2.0 * law.xi * gap)
-        };
-        let (force, stiffness) = (self.forces[crossing], self.stiffnesses[crossing]);
-        let w = direction[crossing];
-        let newton = start + self.scratch[crossing];
-        // s − s⁰ − δ_c − w ρ(s) = 0, times s: α s² − β s − γ = 0.
-        let alpha = 1.0 - w * (q + stiffness);
-        let beta = newton + w * (k - force - stiffness * start);
-        let gamma = w * p;
-        let discriminant = beta * beta + 4.0 * alpha * gamma;
-        // Also false for a NaN discriminant.
-        let real_roots = discriminant >= 0.0;
-        if !real_roots || alpha == 0.0 {
-            return None;
-        }
-        let half = 0.5 * (beta + beta.signum() * discriminant.sqrt());
-        if half == 0.0 {
-            return None;
-        }
-        let in_case = |s: f64| {
-            let (before, after) = contact_case(gap, s);
-            before == leaving && after != leaving && s != 0.0
-        };
-        let step = match (half / alpha, -gamma / half) {
-            (one, other) if in_case(one) && in_case(other) => {
-                if (one - newton).abs() <= (other - newton).abs() {
-                    one
-                } else {
-                    other
-                }
-            }
-            (one, _) if in_case(one) => one,
-            (_, other) if in_case(other) => other,
-            _ => return None,
-        };
-        let departure = (p / step + q * step + k) - force + stiffness * (step - start);
+        let (step, departure) = exact_crossing_step(CrossingPoint {
+            gap: self.gaps[crossing],
+            start: self.steps[crossing],
+            law: HuntCrossley {
+                xi: self.xis[crossing],
+                psi: self.psis[crossing],
+            },
+            force: self.forces[crossing],
+            stiffness: self.stiffnesses[crossing],
+            direction: direction[crossing],
+            delta: self.scratch[crossing],
+        })?;
         let mut largest = 0.0f64;
         for slot in 0..count {
             let candidate = if slot == crossing {
