@@ -1,10 +1,10 @@
-//! Newton's iteration of a contact step on at most [`BLOCK`] tracked points, in fixed lanes
+//! Newton's iteration of a contact step on at most [`WIDE_BLOCK`] tracked points, in fixed lanes
 //! (`docs/modal-tanpura.md`, section 4; the equations of `step.rs`, whose general path takes
 //! more points).
 //!
 //! The bridge's crest and the thread rarely hold more than five tracked points.
 //! [`ContactStep`](super::step::ContactStep) loads their state into fixed arrays of [`BLOCK`]
-//! lanes (the slots past the tracked ones are neutral: no gap, no step, no rest force, no
+//! lanes ([`WIDE_BLOCK`] when more points are tracked, as on a very stiff bridge) (the slots past the tracked ones are neutral: no gap, no step, no rest force, no
 //! coupling) and iterates here, so that each pass (the law, the residual
 //! `R = Δu − Δu_free − G ΔF`, the update `δ = −R − G_{:,A} D y`, the exact finish's direction
 //! `w = G e_c − G_{:,A} D y'`) is a few full-width vector operations with no loop control, no
@@ -15,40 +15,45 @@
 //!
 //! Hand-written rather than on a linear-algebra crate for the reasons of `step.rs`.
 
-use super::solve::{ldl_factor_fixed, ldl_substitute_fixed};
+use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
 use crate::tanpura::contact::HuntCrossley;
 
 /// The lanes of the fixed path: one AVX-512 register of f64, two AVX2 registers.
 pub const BLOCK: usize = 8;
+/// The wide fixed path's lanes, for up to twice as many tracked points.
+pub const WIDE_BLOCK: usize = 16;
+/// The largest active set whose system is solved by the unrolled LDLᵀ (with the exact finish of
+/// a crossing point); larger ones by the general loops, as `ContactStep::update` does.
+const FIXED_SOLVE: usize = 8;
 /// One value per slot.
-pub type Lanes = [f64; BLOCK];
-/// G on the first [`BLOCK`] slots, row by row.
-pub type Block = [Lanes; BLOCK];
+pub type Lanes<const N: usize> = [f64; N];
+/// G on the first `N` slots, row by row.
+pub type Block<const N: usize> = [Lanes<N>; N];
 /// What an update did: the largest component of the applied change (NaN when the state is not
 /// finite) and whether the step is now exact.
 type Update = (f64, bool);
 
 /// The tracked points' state in slot order; the lanes from `count` on are neutral.
 #[derive(Debug, Clone, Copy)]
-pub struct BlockState {
+pub struct BlockState<const N: usize> {
     pub count: usize,
-    pub gaps: Lanes,
-    pub free_steps: Lanes,
-    pub steps: Lanes,
-    pub rest_forces: Lanes,
-    pub xis: Lanes,
-    pub psis: Lanes,
+    pub gaps: Lanes<N>,
+    pub free_steps: Lanes<N>,
+    pub steps: Lanes<N>,
+    pub rest_forces: Lanes<N>,
+    pub xis: Lanes<N>,
+    pub psis: Lanes<N>,
     /// F, c = −∂F/∂Δu and F − F_rest at the last evaluation.
-    pub forces: Lanes,
-    pub stiffnesses: Lanes,
-    pub changes: Lanes,
+    pub forces: Lanes<N>,
+    pub stiffnesses: Lanes<N>,
+    pub changes: Lanes<N>,
 }
 
-/// `values` as lanes (`values` holds at least [`BLOCK`] elements).
+/// `values` as lanes (`values` holds at least `N` elements).
 #[inline(always)]
-pub fn lanes_of(values: &[f64]) -> Lanes {
-    let mut lanes = [0.0; BLOCK];
-    lanes.copy_from_slice(&values[..BLOCK]);
+pub fn lanes_of<const N: usize>(values: &[f64]) -> Lanes<N> {
+    let mut lanes = [0.0; N];
+    lanes.copy_from_slice(&values[..N]);
     lanes
 }
 
@@ -128,13 +133,13 @@ pub fn exact_crossing_step(point: CrossingPoint) -> Option<(f64, f64)> {
     Some((step, departure))
 }
 
-impl BlockState {
+impl<const N: usize> BlockState<N> {
     /// Whether no point can exert a force different from its rest force during the free step
     /// (`ContactStep::settle_if_free`'s test).
     #[inline(always)]
     pub fn free_of_contact(&self) -> bool {
         let mut free = true;
-        for lane in 0..BLOCK {
+        for lane in 0..N {
             let gap = self.gaps[lane];
             free &=
                 self.rest_forces[lane] == 0.0 && gap <= 0.0 && gap - self.free_steps[lane] <= 0.0;
@@ -146,7 +151,7 @@ impl BlockState {
     #[inline(always)]
     pub fn crosses(&self) -> bool {
         let mut crossing = false;
-        for lane in 0..BLOCK {
+        for lane in 0..N {
             let (before, after) = contact_case(self.gaps[lane], self.steps[lane]);
             crossing |= before != after;
         }
@@ -158,7 +163,7 @@ impl BlockState {
     /// [`HuntCrossley::midpoint_force_linear_damping`] in those cases.
     #[inline(always)]
     pub fn evaluate_without_crossing(&mut self) {
-        for lane in 0..BLOCK {
+        for lane in 0..N {
             let (gap, step) = (self.gaps[lane], self.steps[lane]);
             let damping = 2.0 * self.psis[lane] * gap.max(0.0);
             let touching = gap > 0.0;
@@ -202,7 +207,7 @@ impl BlockState {
     #[inline(always)]
     fn crossing_points(&self) -> (usize, usize) {
         let mut count = 0;
-        for lane in 0..BLOCK {
+        for lane in 0..N {
             let (before, after) = contact_case(self.gaps[lane], self.steps[lane]);
             count += usize::from(before != after);
         }
@@ -222,7 +227,12 @@ impl BlockState {
     /// as `ContactStep::newton` does; then the forces at the accepted step. Returns (updates,
     /// converged).
     #[inline(always)]
-    pub fn newton(&mut self, block: &Block, tolerance_m: f64, max_iterations: u32) -> (u32, bool) {
+    pub fn newton(
+        &mut self,
+        block: &Block<N>,
+        tolerance_m: f64,
+        max_iterations: u32,
+    ) -> (u32, bool) {
         let cap = max_iterations.max(1);
         let mut outcome = (cap, false);
         for iteration in 1..=cap {
@@ -251,20 +261,20 @@ impl BlockState {
     /// for the evaluation point's contact cases, taken if it lies in them
     /// (`ContactStep::update`).
     #[inline(always)]
-    fn update(&mut self, block: &Block, crossing: Option<usize>) -> Update {
+    fn update(&mut self, block: &Block<N>, crossing: Option<usize>) -> Update {
         // R = Δu − Δu_free − G ΔF; a point with no force change adds an exact zero.
-        let mut residual = [0.0; BLOCK];
-        for lane in 0..BLOCK {
+        let mut residual = [0.0; N];
+        for lane in 0..N {
             residual[lane] = self.steps[lane] - self.free_steps[lane];
         }
         for (row, &change) in block.iter().zip(&self.changes) {
-            for lane in 0..BLOCK {
+            for lane in 0..N {
                 residual[lane] -= row[lane] * change;
             }
         }
         // A: the points with c > 0, and D = diag(√c) on them.
-        let mut active = [0usize; BLOCK];
-        let mut roots = [0.0; BLOCK];
+        let mut active = [0usize; N];
+        let mut roots = [0.0; N];
         let mut size = 0;
         for slot in 0..self.count {
             if self.stiffnesses[slot] > 0.0 {
@@ -274,15 +284,17 @@ impl BlockState {
             }
         }
         // (I + D G_AA D) y = −D R_A and D y per point (zero off A); with a crossing point c,
-        // also (I + D G_AA D) y' = D G_{A,c} and D y'.
+        // also (I + D G_AA D) y' = D G_{A,c} and D y' (the exact finish needs the factors for a
+        // second right-hand side: the unrolled sizes, as in `ContactStep::update`).
+        let crossing = crossing.filter(|_| size <= FIXED_SOLVE);
         let system = Active {
             block,
             active: &active,
             roots: &roots,
             crossing,
         };
-        let mut weights = [0.0; BLOCK];
-        let mut crossing_weights = [0.0; BLOCK];
+        let mut weights = [0.0; N];
+        let mut crossing_weights = [0.0; N];
         let finite = match size {
             0 => true,
             1 => system.solve::<1>(&residual, &mut weights, &mut crossing_weights),
@@ -292,15 +304,16 @@ impl BlockState {
             5 => system.solve::<5>(&residual, &mut weights, &mut crossing_weights),
             6 => system.solve::<6>(&residual, &mut weights, &mut crossing_weights),
             7 => system.solve::<7>(&residual, &mut weights, &mut crossing_weights),
-            _ => system.solve::<8>(&residual, &mut weights, &mut crossing_weights),
+            8 => system.solve::<8>(&residual, &mut weights, &mut crossing_weights),
+            _ => system.solve_any(size, &residual, &mut weights),
         };
         // δ = −R − G_{:,A} D y.
-        let mut deltas = [0.0; BLOCK];
-        for lane in 0..BLOCK {
+        let mut deltas = [0.0; N];
+        for lane in 0..N {
             deltas[lane] = -residual[lane];
         }
         for (row, &weight) in block.iter().zip(&weights) {
-            for lane in 0..BLOCK {
+            for lane in 0..N {
                 deltas[lane] -= row[lane] * weight;
             }
         }
@@ -311,7 +324,7 @@ impl BlockState {
             }
         }
         let mut largest = 0.0f64;
-        for lane in 0..BLOCK {
+        for lane in 0..N {
             self.steps[lane] += deltas[lane];
             largest = largest.max(deltas[lane].abs());
         }
@@ -330,15 +343,15 @@ impl BlockState {
     #[inline(always)]
     fn finish_exactly(
         &mut self,
-        block: &Block,
+        block: &Block<N>,
         crossing: usize,
-        deltas: &Lanes,
-        crossing_weights: &Lanes,
+        deltas: &Lanes<N>,
+        crossing_weights: &Lanes<N>,
     ) -> Option<f64> {
         // w = G e_c − G_{:,A} D y'.
         let mut direction = block[crossing];
         for (row, &weight) in block.iter().zip(crossing_weights) {
-            for lane in 0..BLOCK {
+            for lane in 0..N {
                 direction[lane] -= row[lane] * weight;
             }
         }
@@ -376,29 +389,29 @@ impl BlockState {
 }
 
 /// The linear system of an update on the active points `A`: `I + D G_AA D`.
-struct Active<'a> {
-    block: &'a Block,
-    active: &'a [usize; BLOCK],
-    roots: &'a Lanes,
+struct Active<'a, const N: usize> {
+    block: &'a Block<N>,
+    active: &'a [usize; N],
+    roots: &'a Lanes<N>,
     crossing: Option<usize>,
 }
 
-impl Active<'_> {
+impl<const N: usize> Active<'_, N> {
     /// `(I + D G_AA D) y = −D R_A` for the `N` active points: writes `D y` into `weights` at
     /// the points' lanes and, with a crossing point c, `D y'` for `(I + D G_AA D) y' = D G_{A,c}`
     /// into `crossing_weights`; returns whether `D y` is finite
     /// (`ContactStep::solve_active_fixed`).
     #[inline(always)]
-    fn solve<const N: usize>(
+    fn solve<const SIZE: usize>(
         &self,
-        residual: &Lanes,
-        weights: &mut Lanes,
-        crossing_weights: &mut Lanes,
+        residual: &Lanes<N>,
+        weights: &mut Lanes<N>,
+        crossing_weights: &mut Lanes<N>,
     ) -> bool {
         let (block, active, roots) = (self.block, self.active, self.roots);
-        let mut matrix = [[0.0; N]; N];
-        let mut y = [0.0; N];
-        for a in 0..N {
+        let mut matrix = [[0.0; SIZE]; SIZE];
+        let mut y = [0.0; SIZE];
+        for a in 0..SIZE {
             let row = &block[active[a]];
             for b in 0..=a {
                 matrix[a][b] = roots[a] * row[active[b]] * roots[b];
@@ -409,21 +422,47 @@ impl Active<'_> {
         ldl_factor_fixed(&mut matrix);
         ldl_substitute_fixed(&matrix, &mut y);
         let mut finite = true;
-        for a in 0..N {
+        for a in 0..SIZE {
             let weight = y[a] * roots[a];
             weights[active[a]] = weight;
             finite &= weight.is_finite();
         }
         if let Some(crossing) = self.crossing {
             let column = &block[crossing];
-            let mut second = [0.0; N];
-            for a in 0..N {
+            let mut second = [0.0; SIZE];
+            for a in 0..SIZE {
                 second[a] = roots[a] * column[active[a]];
             }
             ldl_substitute_fixed(&matrix, &mut second);
-            for a in 0..N {
+            for a in 0..SIZE {
                 crossing_weights[active[a]] = second[a] * roots[a];
             }
+        }
+        finite
+    }
+
+    /// [`Active::solve`] for more than [`FIXED_SOLVE`] active points, by the general path's
+    /// loops (`ContactStep::solve_active_any`, the same arithmetic), with no crossing finish.
+    #[inline(always)]
+    fn solve_any(&self, size: usize, residual: &Lanes<N>, weights: &mut Lanes<N>) -> bool {
+        let (block, active, roots) = (self.block, self.active, self.roots);
+        let mut matrix = [0.0; WIDE_BLOCK * WIDE_BLOCK];
+        let (mut y, mut scratch) = ([0.0; WIDE_BLOCK], [0.0; WIDE_BLOCK]);
+        let matrix = &mut matrix[..size * size];
+        for a in 0..size {
+            let row = &block[active[a]];
+            for b in 0..=a {
+                matrix[a * size + b] = roots[a] * row[active[b]] * roots[b];
+            }
+            matrix[a * size + a] += 1.0;
+            y[a] = -roots[a] * residual[active[a]];
+        }
+        ldl_solve_in_place(matrix, size, &mut y[..size], &mut scratch[..size]);
+        let mut finite = true;
+        for a in 0..size {
+            let weight = y[a] * roots[a];
+            weights[active[a]] = weight;
+            finite &= weight.is_finite();
         }
         finite
     }

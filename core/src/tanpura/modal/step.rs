@@ -27,8 +27,8 @@
 //! would, it joins and the solve is redone before anything moves, so the solve is exact for every
 //! point.
 //!
-//! Up to eight tracked points (nearly every step), the iteration runs in fixed lanes
-//! (`block.rs`), the same iterates bit for bit; the whole contact work of a step is one function
+//! Up to eight tracked points (nearly every step), and up to sixteen, the iteration runs in
+//! fixed lanes (`block.rs`), the same iterates bit for bit; the whole contact work of a step is one function
 //! compiled for the machine's vector unit ([`ContactStep::step`]).
 //!
 //! Hand-written rather than on a linear-algebra crate: the systems are 1–12 points, solved once
@@ -37,6 +37,7 @@
 
 use super::block::{
     contact_case, exact_crossing_step, lanes_of, Block, BlockState, CrossingPoint, BLOCK,
+    WIDE_BLOCK,
 };
 use super::points::ContactPoints;
 use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
@@ -56,7 +57,7 @@ const SLEEP_MARGIN_M: f64 = 10e-6;
 pub struct ContactStep {
     capacity: usize,
     /// The length of the per-slot arrays and the block's row stride: `capacity`, at least
-    /// [`BLOCK`], so that the first [`BLOCK`] slots always exist.
+    /// [`WIDE_BLOCK`], so that the fixed lanes' slots always exist.
     slot_stride: usize,
     /// a_i per point, m, after every step.
     pub gaps_m: Vec<f64>,
@@ -102,8 +103,9 @@ pub struct ContactStep {
     /// G on the tracked points, with row stride `slot_stride`; zero in every row and column of
     /// a slot past the tracked ones (see [`ContactStep::clear_slot`]).
     block: Vec<f64>,
-    /// Its first [`BLOCK`] rows and columns, for [`ContactStep::solve_block`].
-    block_lanes: Block,
+    /// Its first [`BLOCK`] and [`WIDE_BLOCK`] rows and columns, for the solve in fixed lanes.
+    block_lanes: Block<BLOCK>,
+    wide_block_lanes: Box<Block<WIDE_BLOCK>>,
     /// Whether every solve takes the general path (for the test that the two agree).
     general_path_only: bool,
     residual: Vec<f64>,
@@ -224,7 +226,7 @@ impl ContactStep {
     /// Room for `capacity` points. Allocates.
     pub fn new(capacity: usize) -> Self {
         let zeros = || vec![0.0; capacity];
-        let slot_stride = capacity.max(BLOCK);
+        let slot_stride = capacity.max(WIDE_BLOCK);
         let slot_zeros = || vec![0.0; slot_stride];
         Self {
             capacity,
@@ -255,6 +257,7 @@ impl ContactStep {
             loaded_count: 0,
             block: vec![0.0; slot_stride * slot_stride],
             block_lanes: [[0.0; BLOCK]; BLOCK],
+            wide_block_lanes: Box::new([[0.0; WIDE_BLOCK]; WIDE_BLOCK]),
             general_path_only: false,
             residual: slot_zeros(),
             active: vec![0; slot_stride],
@@ -357,6 +360,7 @@ impl ContactStep {
             values.fill(0.0);
         }
         self.block_lanes = [[0.0; BLOCK]; BLOCK];
+        *self.wide_block_lanes = [[0.0; WIDE_BLOCK]; WIDE_BLOCK];
         self.awake_count = points.len();
         for i in 0..points.len() {
             self.awake[i] = 1.0;
@@ -440,8 +444,8 @@ impl ContactStep {
     }
 
     /// Makes `slot` neutral: no gap, step, correction or rest force, and no coupling with any
-    /// slot. Every slot past the tracked ones is neutral, as [`ContactStep::solve_block`], which
-    /// runs over [`BLOCK`] slots, needs.
+    /// slot. Every slot past the tracked ones is neutral, as the solve in fixed lanes
+    /// (`block.rs`), which runs over [`BLOCK`] or [`WIDE_BLOCK`] slots, needs.
     fn clear_slot(&mut self, slot: usize) {
         let stride = self.slot_stride;
         self.gaps[slot] = 0.0;
@@ -455,11 +459,14 @@ impl ContactStep {
         }
     }
 
-    /// The block's first [`BLOCK`] rows and columns into `block_lanes`.
+    /// The block's first rows and columns into `block_lanes` and `wide_block_lanes`.
     fn copy_block_lanes(&mut self) {
         let stride = self.slot_stride;
         for (slot, row) in self.block_lanes.iter_mut().enumerate() {
             row.copy_from_slice(&self.block[slot * stride..slot * stride + BLOCK]);
+        }
+        for (slot, row) in self.wide_block_lanes.iter_mut().enumerate() {
+            row.copy_from_slice(&self.block[slot * stride..slot * stride + WIDE_BLOCK]);
         }
     }
 
@@ -522,12 +529,26 @@ impl ContactStep {
     /// The tracked points' forces for the current free steps: none if nothing can touch, else
     /// Newton's iteration from the current steps and the forces at the accepted step (for the
     /// update, the outputs and the ledger). Returns the updates and, if Newton ran, whether it
-    /// converged. Up to [`BLOCK`] points, the first update runs in fixed lanes
-    /// ([`ContactStep::solve_block`]).
+    /// converged. Up to [`BLOCK`] points (nearly every step) the iteration runs in [`BLOCK`]
+    /// fixed lanes (`block.rs`), up to [`WIDE_BLOCK`] in as many; the general path takes more.
     #[inline(always)]
     fn solve_tracked(&mut self, settings: &NewtonSettings) -> (u32, Option<bool>) {
+        let (tolerance, cap) = (settings.tolerance_m, settings.max_iterations);
         if self.count <= BLOCK && !self.general_path_only {
-            return self.solve_block(settings);
+            let mut state = self.block_state::<BLOCK>();
+            if state.free_of_contact() {
+                return self.settle_free();
+            }
+            let outcome = state.newton(&self.block_lanes, tolerance, cap);
+            return self.take_block_solution(&state, outcome);
+        }
+        if self.count <= WIDE_BLOCK && !self.general_path_only {
+            let mut state = self.block_state::<WIDE_BLOCK>();
+            if state.free_of_contact() {
+                return self.settle_free();
+            }
+            let outcome = state.newton(&self.wide_block_lanes, tolerance, cap);
+            return self.take_block_solution(&state, outcome);
         }
         if self.settle_if_free() {
             return (0, None);
@@ -537,42 +558,52 @@ impl ContactStep {
         (updates, Some(done))
     }
 
-    /// [`ContactStep::solve_tracked`] on at most [`BLOCK`] points, in fixed lanes (`block.rs`):
-    /// the same iterates (to the sign of a zero).
+    /// The tracked points' state in `N` fixed lanes (`count ≤ N`; the slots past them are
+    /// neutral).
     #[inline(always)]
-    fn solve_block(&mut self, settings: &NewtonSettings) -> (u32, Option<bool>) {
-        let count = self.count;
-        let mut block = BlockState {
-            count,
+    fn block_state<const N: usize>(&self) -> BlockState<N> {
+        BlockState {
+            count: self.count,
             gaps: lanes_of(&self.gaps),
             free_steps: lanes_of(&self.free_steps),
             steps: lanes_of(&self.steps),
             rest_forces: lanes_of(&self.rest_forces),
             xis: lanes_of(&self.xis),
             psis: lanes_of(&self.psis),
-            forces: [0.0; BLOCK],
-            stiffnesses: [0.0; BLOCK],
-            changes: [0.0; BLOCK],
-        };
-        if block.free_of_contact() {
-            self.loaded_count = 0;
-            self.steps[..count].copy_from_slice(&self.free_steps[..count]);
-            self.forces[..count].fill(0.0);
-            self.changes[..count].fill(0.0);
-            return (0, None);
+            forces: [0.0; N],
+            stiffnesses: [0.0; N],
+            changes: [0.0; N],
         }
-        let (updates, converged) = block.newton(
-            &self.block_lanes,
-            settings.tolerance_m,
-            settings.max_iterations,
-        );
-        self.steps[..BLOCK].copy_from_slice(&block.steps);
-        self.forces[..count].copy_from_slice(&block.forces[..count]);
-        self.stiffnesses[..count].copy_from_slice(&block.stiffnesses[..count]);
-        self.changes[..count].copy_from_slice(&block.changes[..count]);
+    }
+
+    /// The free step as the solution, when nothing can touch (see
+    /// [`ContactStep::settle_if_free`]).
+    #[inline(always)]
+    fn settle_free(&mut self) -> (u32, Option<bool>) {
+        let count = self.count;
+        self.loaded_count = 0;
+        self.steps[..count].copy_from_slice(&self.free_steps[..count]);
+        self.forces[..count].fill(0.0);
+        self.changes[..count].fill(0.0);
+        (0, None)
+    }
+
+    /// Takes the steps and forces of a solve in fixed lanes (`block.rs`; (updates, converged)
+    /// in `outcome`) and lists the loaded slots.
+    #[inline(always)]
+    fn take_block_solution<const N: usize>(
+        &mut self,
+        state: &BlockState<N>,
+        (updates, converged): (u32, bool),
+    ) -> (u32, Option<bool>) {
+        let count = self.count;
+        self.steps[..N].copy_from_slice(&state.steps);
+        self.forces[..count].copy_from_slice(&state.forces[..count]);
+        self.stiffnesses[..count].copy_from_slice(&state.stiffnesses[..count]);
+        self.changes[..count].copy_from_slice(&state.changes[..count]);
         self.loaded_count = 0;
         for slot in 0..count {
-            if block.changes[slot] != 0.0 {
+            if state.changes[slot] != 0.0 {
                 self.loaded[self.loaded_count] = slot;
                 self.loaded_count += 1;
             }
@@ -580,7 +611,7 @@ impl ContactStep {
         (updates, Some(converged))
     }
 
-    /// Makes every solve take the general path, not [`ContactStep::solve_block`] (for tests).
+    /// Makes every solve take the general path, not the fixed lanes (for tests).
     #[cfg(test)]
     pub(super) fn take_general_path_only(&mut self) {
         self.general_path_only = true;
