@@ -216,12 +216,12 @@ fn one_dot<T: Real, S: Simd>(simd: S, x: &[T::Lanes<S>], row: &[T::Lanes<S>]) ->
 
 /// Dot products of several rows of a matrix with one vector: `out[j] = matrix[rows[j]] · x`,
 /// or with `SCATTER`, `out[rows[j]] = matrix[rows[j]] · x`.
-struct Dots<'a, T: Real, const SCATTER: bool> {
-    matrix: &'a [T],
-    stride: usize,
-    rows: &'a [usize],
-    x: &'a [T],
-    out: &'a mut [f64],
+pub(super) struct Dots<'a, T: Real, const SCATTER: bool> {
+    pub matrix: &'a [T],
+    pub stride: usize,
+    pub rows: &'a [usize],
+    pub x: &'a [T],
+    pub out: &'a mut [f64],
 }
 
 impl<T: Real, const SCATTER: bool> WithSimd for Dots<'_, T, SCATTER> {
@@ -274,11 +274,11 @@ impl<T: Real, const SCATTER: bool> WithSimd for Dots<'_, T, SCATTER> {
 
 /// [`Dots`] of the first `out.len()` rows, walked in order without an index list (every
 /// contact point's free step, each step): `out[j] = matrix[j] · x`, the same sums bit for bit.
-struct LeadingDots<'a, T: Real> {
-    matrix: &'a [T],
-    stride: usize,
-    x: &'a [T],
-    out: &'a mut [f64],
+pub(super) struct LeadingDots<'a, T: Real> {
+    pub matrix: &'a [T],
+    pub stride: usize,
+    pub x: &'a [T],
+    pub out: &'a mut [f64],
 }
 
 impl<T: Real> WithSimd for LeadingDots<'_, T> {
@@ -397,20 +397,20 @@ const REGISTER_ROWS: usize = 8;
 /// free step `s ← a p − b r`. Returns the nut force `c · r` after the step. The
 /// modal force of the first [`REGISTER_ROWS`] rows never leaves the registers, so a pass stores
 /// only r, p, the next free step and the whole step.
-struct AdvanceAndPrepare<'a, T: Real> {
-    a: &'a [T],
-    b: &'a [T],
-    c: &'a [T],
-    matrix: &'a [T],
-    stride: usize,
-    rows: &'a [usize],
-    forces: &'a [T],
+pub(super) struct AdvanceAndPrepare<'a, T: Real> {
+    pub a: &'a [T],
+    pub b: &'a [T],
+    pub c: &'a [T],
+    pub matrix: &'a [T],
+    pub stride: usize,
+    pub rows: &'a [usize],
+    pub forces: &'a [T],
     /// The arrays' length: scratch for the rows beyond [`REGISTER_ROWS`] on entry, the whole
     /// step `s + b Σ_j ΔF_j Ψ_j` on return.
-    work: &'a mut [T],
-    s: &'a mut [T],
-    r: &'a mut [T],
-    p: &'a mut [T],
+    pub work: &'a mut [T],
+    pub s: &'a mut [T],
+    pub r: &'a mut [T],
+    pub p: &'a mut [T],
 }
 
 impl<T: Real> AdvanceAndPrepare<'_, T> {
@@ -520,26 +520,6 @@ impl Kernels {
     ) {
         debug_assert!(out.len() >= rows.len() && x.len() <= stride);
         self.arch.dispatch(Dots::<T, false> {
-            matrix,
-            stride,
-            rows,
-            x,
-            out,
-        });
-    }
-
-    /// `out[rows[j]] = matrix[rows[j]] · x` for every listed row: [`Kernels::dots`] with each
-    /// sum written at its row's index, bit for bit.
-    pub fn scattered_dots<T: Real>(
-        &self,
-        matrix: &[T],
-        stride: usize,
-        rows: &[usize],
-        x: &[T],
-        out: &mut [f64],
-    ) {
-        debug_assert!(rows.iter().all(|&row| row < out.len()) && x.len() <= stride);
-        self.arch.dispatch(Dots::<T, true> {
             matrix,
             stride,
             rows,

@@ -42,9 +42,10 @@ use crate::simd::CacheAligned;
 use crate::tanpura::excitation::{finger_height_m, Pluck};
 use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
 use crate::tanpura::string::StringParameters;
-use lanes::{padded_lanes, Kernels, Real, LANE_PADDING};
+use lanes::{padded_lanes, AdvanceAndPrepare, Dots, Kernels, LeadingDots, Real, LANE_PADDING};
 use modes::{ModeSet, AUDIBLE_LIMIT_HZ, MODE_CAPACITY};
 use points::{grid_points, ContactPoints};
+use pulp::{Simd, WithSimd};
 use solve::{linearised_fundamental, StaticSolver};
 use std::f64::consts::PI;
 use step::ContactStep;
@@ -453,8 +454,16 @@ impl<T: Real> ModalString<T> {
     }
 
     /// Advances one sample (eq. M1 with Newton on the tracked points, section 4). Allocation-free;
-    /// never panics.
+    /// never panics. The whole step (dot products, contact solve, mode update) runs as one
+    /// function compiled for the machine's vector unit.
     pub fn step(&mut self) {
+        let kernels = self.kernels;
+        kernels.arch.dispatch(WholeStep { string: self });
+    }
+
+    /// [`ModalString::step`] on the vector unit `simd`.
+    #[inline(always)]
+    fn step_on<S: Simd>(&mut self, simd: S) {
         // The kernels run over the kept modes, padded to whole registers; `step` holds s_free.
         let lanes = self.lanes;
         // Every awake point's free step Ψ_i s_free, one dot product per point; far points are
@@ -465,25 +474,31 @@ impl<T: Real> ModalString<T> {
             self.sleep_far_points();
         }
         if let Some(free_steps) = self.contact.point_free_steps_mut(self.points.len()) {
-            self.kernels
-                .leading_dots(&self.shapes, MODE_CAPACITY, &self.step[..lanes], free_steps);
+            LeadingDots {
+                matrix: &self.shapes,
+                stride: MODE_CAPACITY,
+                x: &self.step[..lanes],
+                out: free_steps,
+            }
+            .with_simd(simd);
         } else {
             let (rows, free_steps) = self.contact.awake_rows();
-            self.kernels.scattered_dots(
-                &self.shapes,
-                MODE_CAPACITY,
+            Dots::<T, true> {
+                matrix: &self.shapes,
+                stride: MODE_CAPACITY,
                 rows,
-                &self.step[..lanes],
-                free_steps,
-            );
+                x: &self.step[..lanes],
+                out: free_steps,
+            }
+            .with_simd(simd);
         }
         // The contact solve, and the tracking for the next step (which reads only the gaps and
         // forces, not the modes).
         let outcome = self.contact.step(
+            simd,
             &self.points,
             &self.config.newton,
             self.config.track_energy,
-            &self.kernels,
             TRACKING_BAND_M,
             2.0 * TRACKING_BAND_M,
         );
@@ -500,19 +515,20 @@ impl<T: Real> ModalString<T> {
             *value = T::from_f64(*change);
             bridge_change += change;
         }
-        let nut_change = self.kernels.advance_and_prepare(
-            &self.a[..lanes],
-            &self.b[..lanes],
-            &self.nut_weights[..lanes],
-            &self.shapes,
-            MODE_CAPACITY,
-            loaded,
-            &self.loaded_forces[..loaded.len()],
-            &mut self.whole_step[..lanes],
-            &mut self.step[..lanes],
-            &mut self.modal[..lanes],
-            &mut self.velocity[..lanes],
-        );
+        let nut_change = AdvanceAndPrepare {
+            a: &self.a[..lanes],
+            b: &self.b[..lanes],
+            c: &self.nut_weights[..lanes],
+            matrix: &self.shapes,
+            stride: MODE_CAPACITY,
+            rows: loaded,
+            forces: &self.loaded_forces[..loaded.len()],
+            work: &mut self.whole_step[..lanes],
+            s: &mut self.step[..lanes],
+            r: &mut self.modal[..lanes],
+            p: &mut self.velocity[..lanes],
+        }
+        .with_simd(simd);
         if self.config.track_energy {
             self.cumulative_losses_j += (0..self.modes.count())
                 .map(|k| {
@@ -871,6 +887,20 @@ fn first_mode_projection(start_m: f64, length_m: f64, k: usize) -> f64 {
         }
     };
     (2.0 / length_m) * 0.5 * (cosine_integral(alpha - beta) - cosine_integral(alpha + beta))
+}
+
+/// [`ModalString::step`] as one function for the vector unit pulp picks.
+struct WholeStep<'a, T: Real> {
+    string: &'a mut ModalString<T>,
+}
+
+impl<T: Real> WithSimd for WholeStep<'_, T> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        self.string.step_on(simd);
+    }
 }
 
 #[cfg(test)]

@@ -29,7 +29,8 @@
 //!
 //! Up to eight tracked points (nearly every step), and up to sixteen, the iteration runs in
 //! fixed lanes (`block.rs`), the same iterates bit for bit; the whole contact work of a step is one function
-//! compiled for the machine's vector unit ([`ContactStep::step`]).
+//! compiled for the machine's vector unit, inlined into the modal string's step
+//! (`ContactStep::step`).
 //!
 //! Hand-written rather than on a linear-algebra crate: the systems are 1–12 points, solved once
 //! or twice per sample on the audio thread; the fixed-size LDLᵀ of `solve.rs` is unrolled by the
@@ -42,7 +43,6 @@ use super::block::{
 use super::points::ContactPoints;
 use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
 use crate::newton::NewtonSettings;
-use crate::simd::Kernels;
 use crate::tanpura::contact::HuntCrossley;
 use pulp::{Simd, WithSimd};
 
@@ -125,7 +125,7 @@ pub struct ContactStep {
     loaded_changes_n: Vec<f64>,
 }
 
-/// What one step's contact work ([`ContactStep::step`]) reports.
+/// What one step's contact work (`ContactStep::step`) reports.
 #[derive(Debug, Clone, Copy)]
 pub struct ContactOutcome {
     /// Newton updates, and whether the last met the tolerance.
@@ -137,10 +137,10 @@ pub struct ContactOutcome {
     pub penetration_m: f64,
 }
 
-/// The contact work of one step ([`ContactStep::step`]) as one function compiled for the
-/// machine's vector unit: every method it calls is inlined into it, so its scalar arithmetic
-/// uses the unit's fused multiply-adds and VEX encoding, and its passes over all points run in
-/// the unit's full width.
+/// The contact work of one step ([`ContactStep::step`]), compiled for the machine's vector unit
+/// with the rest of the step: every method it calls is inlined into it, so its scalar
+/// arithmetic uses the unit's VEX encoding and its passes over all points run in the unit's full
+/// width.
 struct ContactPass<'a> {
     contact: &'a mut ContactStep,
     points: &'a ContactPoints,
@@ -470,26 +470,29 @@ impl ContactStep {
         }
     }
 
-    /// One step's contact work on the vector unit of `kernels`: [`ContactStep::solve`], the
-    /// damping loss (with `track_energy`), [`ContactStep::finish_step`] and
-    /// [`ContactStep::update_tracking`] with `band_m` and `release_m`.
-    pub fn step(
+    /// One step's contact work on the vector unit `simd` (inlined into the modal string's step,
+    /// which runs as one function compiled for it): [`ContactStep::solve`], the damping loss
+    /// (with `track_energy`), [`ContactStep::finish_step`] and [`ContactStep::update_tracking`]
+    /// with `band_m` and `release_m`.
+    #[inline(always)]
+    pub(super) fn step<S: Simd>(
         &mut self,
+        simd: S,
         points: &ContactPoints,
         settings: &NewtonSettings,
         track_energy: bool,
-        kernels: &Kernels,
         band_m: f64,
         release_m: f64,
     ) -> ContactOutcome {
-        kernels.arch.dispatch(ContactPass {
+        ContactPass {
             contact: self,
             points,
             settings,
             track_energy,
             band_m,
             release_m,
-        })
+        }
+        .with_simd(simd)
     }
 
     /// Solves the step's contact (every point's free step must be in place, from
