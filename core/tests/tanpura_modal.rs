@@ -319,3 +319,39 @@ fn f32_modes_follow_the_f64_path() {
     assert!(power > 0.0);
     assert!(relative < 1e-3, "relative RMS difference {relative:e}");
 }
+
+/// `TanpuraVoice::process` (which runs a modal string's steps between sleep checks as one call
+/// on the vector unit) gives `next_sample`'s samples bit for bit, in blocks of every size from
+/// one sample up, through a pluck, its ringing, the sleep check and the string falling asleep,
+/// on both modal tiers.
+#[test]
+fn modal_voice_blocks_equal_its_samples() {
+    use javari_core::tanpura::quality::Quality;
+    use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
+    for quality in [Quality::Live, Quality::Draft] {
+        let settings = VoiceSettings {
+            quality,
+            // A short decay, so that the string falls asleep within the test.
+            gamma_per_s: 20.0,
+            ..VoiceSettings::default()
+        };
+        let mut by_blocks = TanpuraVoice::new(&settings, 44_100.0);
+        let mut by_samples = by_blocks.clone();
+        by_blocks.pluck(&Pluck::default());
+        by_samples.pluck(&Pluck::default());
+        let sizes = [1, 7, 64, 255, 256, 257, 1000, 4096];
+        let (mut blocks, mut samples) = (Vec::new(), Vec::new());
+        for size in sizes.iter().cycle().take(160) {
+            let mut block = vec![0.0f32; *size];
+            by_blocks.process(&mut block);
+            blocks.extend(block.iter().map(|x| x.to_bits()));
+            samples.extend((0..*size).map(|_| by_samples.next_sample().to_bits()));
+        }
+        assert!(blocks == samples, "{quality:?}: blocks part from samples");
+        assert!(
+            !by_blocks.is_active(),
+            "{quality:?}: the string never fell asleep"
+        );
+        assert!(blocks.iter().any(|&bits| f32::from_bits(bits) != 0.0));
+    }
+}

@@ -463,6 +463,9 @@ struct Slot {
     level: f32,
 }
 
+/// Samples a voice renders at a time in [`run_slot`] (a stack buffer).
+const VOICE_RUN: usize = 64;
+
 /// Runs `slot`'s voice for `length` samples, handing each scaled sample to `emit(index, value)`,
 /// and updates the slot's level. A voice that blows up is silenced and emits nothing more.
 fn run_slot(slot: &mut Slot, release: f32, length: usize, mut emit: impl FnMut(usize, f32)) {
@@ -472,17 +475,26 @@ fn run_slot(slot: &mut Slot, release: f32, length: usize, mut emit: impl FnMut(u
     }
     let scale = (slot.level_factor / NEWTONS_AT_FULL_SCALE) as f32;
     let mut level = slot.level;
-    for index in 0..length {
-        let value = slot.delay.process(slot.voice.next_sample() * scale);
-        if !value.is_finite() {
-            // Fail soft: a voice that blew up is silenced, never passed on.
-            slot.voice.reset();
-            slot.delay.clear();
-            level = 0.0;
-            break;
+    // The voice renders a run of samples at a time (`TanpuraVoice::process`: the samples of
+    // `next_sample`, with one dispatch to the vector unit per run for a modal string).
+    let mut run = [0.0f32; VOICE_RUN];
+    let mut start = 0;
+    'samples: while start < length {
+        let count = (length - start).min(VOICE_RUN);
+        slot.voice.process(&mut run[..count]);
+        for (index, &sample) in (start..).zip(&run[..count]) {
+            let value = slot.delay.process(sample * scale);
+            if !value.is_finite() {
+                // Fail soft: a voice that blew up is silenced, never passed on.
+                slot.voice.reset();
+                slot.delay.clear();
+                level = 0.0;
+                break 'samples;
+            }
+            emit(index, value);
+            level = value.abs().max(level * release);
         }
-        emit(index, value);
-        level = value.abs().max(level * release);
+        start += count;
     }
     slot.level = level;
 }

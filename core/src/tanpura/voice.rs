@@ -554,23 +554,47 @@ impl TanpuraVoice {
         };
         self.samples_since_sleep_check += 1;
         if self.samples_since_sleep_check >= SLEEP_CHECK_INTERVAL {
-            self.samples_since_sleep_check = 0;
-            if self.string().vibration_energy_j() < SLEEP_ENERGY_J {
-                self.string_mut().settle_to_rest();
-                self.sleeping = true;
-                if oversample > 1 {
-                    let decimator = &self.decimators[oversample - 1];
-                    self.tail_remaining = decimator.taps().len() / oversample + 1;
-                }
-            }
+            self.check_sleep();
         }
         output as f32
     }
 
-    /// Fills `output` with consecutive samples (overwrites).
+    /// Every [`SLEEP_CHECK_INTERVAL`] samples: puts a decayed string to sleep.
+    fn check_sleep(&mut self) {
+        self.samples_since_sleep_check = 0;
+        if self.string().vibration_energy_j() < SLEEP_ENERGY_J {
+            self.string_mut().settle_to_rest();
+            self.sleeping = true;
+            let oversample = self.oversample();
+            if oversample > 1 {
+                let decimator = &self.decimators[oversample - 1];
+                self.tail_remaining = decimator.taps().len() / oversample + 1;
+            }
+        }
+    }
+
+    /// Fills `output` with consecutive samples (overwrites): [`TanpuraVoice::next_sample`]'s
+    /// samples bit for bit. A ringing modal string runs its steps between sleep checks as one
+    /// call ([`ModalString::step_into`]: one dispatch to the vector unit for the run, not one a
+    /// sample).
     pub fn process(&mut self, output: &mut [f32]) {
-        for sample in output {
-            *sample = self.next_sample();
+        let mut done = 0;
+        while done < output.len() {
+            let nut_weight = self.settings.nut_pickup_weight;
+            let until_check = SLEEP_CHECK_INTERVAL.saturating_sub(self.samples_since_sleep_check);
+            let sleeping = self.sleeping;
+            if let (false, TierString::Modal(string)) = (sleeping, self.string_mut()) {
+                let run = (until_check.max(1) as usize).min(output.len() - done);
+                string.step_into(&mut output[done..done + run], nut_weight);
+                done += run;
+                self.samples_since_sleep_check += run as u32;
+                if self.samples_since_sleep_check >= SLEEP_CHECK_INTERVAL {
+                    self.check_sleep();
+                }
+                continue;
+            }
+            output[done] = self.next_sample();
+            done += 1;
         }
     }
 

@@ -461,6 +461,18 @@ impl<T: Real> ModalString<T> {
         kernels.arch.dispatch(WholeStep { string: self });
     }
 
+    /// [`ModalString::step`] once per element of `output`, writing each step's pickup signal
+    /// `w ΔF_nut + (1 − w) ΔF_bridge` (`w = nut_weight`, N) as f32: one dispatch to the vector
+    /// unit for the whole run.
+    pub fn step_into(&mut self, output: &mut [f32], nut_weight: f64) {
+        let kernels = self.kernels;
+        kernels.arch.dispatch(StepRun {
+            string: self,
+            output,
+            nut_weight,
+        });
+    }
+
     /// [`ModalString::step`] on the vector unit `simd`.
     #[inline(always)]
     fn step_on<S: Simd>(&mut self, simd: S) {
@@ -887,6 +899,28 @@ fn first_mode_projection(start_m: f64, length_m: f64, k: usize) -> f64 {
         }
     };
     (2.0 / length_m) * 0.5 * (cosine_integral(alpha - beta) - cosine_integral(alpha + beta))
+}
+
+/// [`ModalString::step_into`] as one function for the vector unit pulp picks.
+struct StepRun<'a, T: Real> {
+    string: &'a mut ModalString<T>,
+    output: &'a mut [f32],
+    nut_weight: f64,
+}
+
+impl<T: Real> WithSimd for StepRun<'_, T> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let (string, weight) = (self.string, self.nut_weight);
+        for sample in self.output {
+            string.step_on(simd);
+            let pickup =
+                weight * string.nut_force_change_n + (1.0 - weight) * string.bridge_force_change_n;
+            *sample = pickup as f32;
+        }
+    }
 }
 
 /// [`ModalString::step`] as one function for the vector unit pulp picks.
