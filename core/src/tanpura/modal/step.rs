@@ -407,7 +407,7 @@ impl ContactStep {
             self.block[slot * stride + other] = value;
             self.block[other * stride + slot] = value;
         }
-        self.copy_block_lanes();
+        self.copy_block_lanes(slot);
     }
 
     /// Stops tracking the point in `slot`: the last slot moves into it, and the last slot is
@@ -440,7 +440,8 @@ impl ContactStep {
             self.block[slot * stride + slot] = self.block[last * stride + last];
         }
         self.clear_slot(last);
-        self.copy_block_lanes();
+        self.copy_block_lanes(slot);
+        self.copy_block_lanes(last);
     }
 
     /// Makes `slot` neutral: no gap, step, correction or rest force, and no coupling with any
@@ -459,14 +460,24 @@ impl ContactStep {
         }
     }
 
-    /// The block's first rows and columns into `block_lanes` and `wide_block_lanes`.
-    fn copy_block_lanes(&mut self) {
-        let stride = self.slot_stride;
-        for (slot, row) in self.block_lanes.iter_mut().enumerate() {
-            row.copy_from_slice(&self.block[slot * stride..slot * stride + BLOCK]);
+    /// Row and column `slot` of the block's first rows and columns into `block_lanes` and
+    /// `wide_block_lanes` (after they changed).
+    fn copy_block_lanes(&mut self, slot: usize) {
+        if slot >= WIDE_BLOCK {
+            return;
         }
-        for (slot, row) in self.wide_block_lanes.iter_mut().enumerate() {
-            row.copy_from_slice(&self.block[slot * stride..slot * stride + WIDE_BLOCK]);
+        let stride = self.slot_stride;
+        for other in 0..WIDE_BLOCK {
+            let (row, column) = (
+                self.block[slot * stride + other],
+                self.block[other * stride + slot],
+            );
+            self.wide_block_lanes[slot][other] = row;
+            self.wide_block_lanes[other][slot] = column;
+            if slot < BLOCK && other < BLOCK {
+                self.block_lanes[slot][other] = row;
+                self.block_lanes[other][slot] = column;
+            }
         }
     }
 
@@ -540,7 +551,7 @@ impl ContactStep {
         if self.count <= BLOCK && !self.general_path_only {
             let mut state = self.block_state::<BLOCK>();
             if state.free_of_contact() {
-                return self.settle_free();
+                return self.settle_free::<BLOCK>();
             }
             let outcome = state.newton(&self.block_lanes, tolerance, cap);
             return self.take_block_solution(&state, outcome);
@@ -548,7 +559,7 @@ impl ContactStep {
         if self.count <= WIDE_BLOCK && !self.general_path_only {
             let mut state = self.block_state::<WIDE_BLOCK>();
             if state.free_of_contact() {
-                return self.settle_free();
+                return self.settle_free::<WIDE_BLOCK>();
             }
             let outcome = state.newton(&self.wide_block_lanes, tolerance, cap);
             return self.take_block_solution(&state, outcome);
@@ -580,14 +591,16 @@ impl ContactStep {
     }
 
     /// The free step as the solution, when nothing can touch (see
-    /// [`ContactStep::settle_if_free`]).
+    /// [`ContactStep::settle_if_free`]), on the first `N` slots (`count ≤ N`; the neutral slots
+    /// stay neutral): copies of a fixed length, which compile to a few vector moves rather than
+    /// calls into libc.
     #[inline(always)]
-    fn settle_free(&mut self) -> (u32, Option<bool>) {
-        let count = self.count;
+    fn settle_free<const N: usize>(&mut self) -> (u32, Option<bool>) {
         self.loaded_count = 0;
-        self.steps[..count].copy_from_slice(&self.free_steps[..count]);
-        self.forces[..count].fill(0.0);
-        self.changes[..count].fill(0.0);
+        let free_steps: [f64; N] = lanes_of(&self.free_steps);
+        self.steps[..N].copy_from_slice(&free_steps);
+        self.forces[..N].fill(0.0);
+        self.changes[..N].fill(0.0);
         (0, None)
     }
 
@@ -600,10 +613,12 @@ impl ContactStep {
         (updates, converged): (u32, bool),
     ) -> (u32, Option<bool>) {
         let count = self.count;
+        // Whole lanes (fixed-length copies, no calls into libc); the lanes past the tracked
+        // points hold the neutral slots' zero forces.
         self.steps[..N].copy_from_slice(&state.steps);
-        self.forces[..count].copy_from_slice(&state.forces[..count]);
-        self.stiffnesses[..count].copy_from_slice(&state.stiffnesses[..count]);
-        self.changes[..count].copy_from_slice(&state.changes[..count]);
+        self.forces[..N].copy_from_slice(&state.forces);
+        self.stiffnesses[..N].copy_from_slice(&state.stiffnesses);
+        self.changes[..N].copy_from_slice(&state.changes);
         self.loaded_count = 0;
         for slot in 0..count {
             if state.changes[slot] != 0.0 {
