@@ -4,8 +4,9 @@
 //!
 //! The bridge's crest and the thread rarely hold more than five tracked points.
 //! [`ContactStep`](super::step::ContactStep) loads their state into fixed arrays of [`BLOCK`]
-//! lanes ([`WIDE_BLOCK`] when more points are tracked, as on a very stiff bridge) (the slots past the tracked ones are neutral: no gap, no step, no rest force, no
-//! coupling) and iterates here, so that each pass (the law, the residual
+//! lanes, or [`WIDE_BLOCK`] when more points are tracked (a very stiff bridge); the slots past
+//! the tracked ones are neutral (no gap, no step, no rest force, no coupling). It iterates here,
+//! so that each pass (the law, the residual
 //! `R = Δu − Δu_free − G ΔF`, the update `δ = −R − G_{:,A} D y`, the exact finish's direction
 //! `w = G e_c − G_{:,A} D y'`) is a few full-width vector operations with no loop control, no
 //! bounds checks and no overlap checks between arrays of one struct. Every value is formed by
