@@ -28,7 +28,7 @@
 //! point.
 //!
 //! Up to eight tracked points (nearly every step), and up to sixteen, the iteration runs in
-//! fixed lanes (`block.rs`), the same iterates bit for bit; the whole contact work of a step is one function
+//! fixed lanes (`block.rs`), the same iterates bit for bit. The whole contact work of a step is
 //! compiled for the machine's vector unit, inlined into the modal string's step
 //! (`ContactStep::step`).
 //!
@@ -507,8 +507,8 @@ impl ContactStep {
     }
 
     /// Solves the step's contact (every point's free step must be in place, from
-    /// [`ContactStep::point_free_steps_mut`]). A far point that would touch during the step joins and the
-    /// solve is redone. Returns (Newton updates, converged).
+    /// [`ContactStep::point_free_steps_mut`]). A far point that would touch during the step joins
+    /// and the solve is redone. Returns (Newton updates, converged).
     #[inline(always)]
     pub fn solve(
         &mut self,
