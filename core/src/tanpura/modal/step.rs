@@ -508,7 +508,8 @@ impl ContactStep {
 
     /// Solves the step's contact (every point's free step must be in place, from
     /// [`ContactStep::point_free_steps_mut`]). A far point that would touch during the step joins
-    /// and the solve is redone. Returns (Newton updates, converged).
+    /// and the solve is redone; whether a far point then lies within `band_m` of contact is
+    /// noted for [`ContactStep::update_tracking`]. Returns (Newton updates, converged).
     #[inline(always)]
     pub fn solve(
         &mut self,
