@@ -10,6 +10,13 @@ use super::modal::ModalString;
 use super::string::StringParameters;
 use crate::newton::NewtonStats;
 
+/// The pickup signal from a step's force changes at nut and bridge, N:
+/// `w · ΔF_nut + (1 − w) · ΔF_bridge` with `w = nut_weight`.
+#[inline(always)]
+pub fn weighted_pickup_n(nut_weight: f64, nut_change_n: f64, bridge_change_n: f64) -> f64 {
+    nut_weight * nut_change_n + (1.0 - nut_weight) * bridge_change_n
+}
+
 /// The string a tier runs.
 #[derive(Debug, Clone)]
 pub enum TierString {
@@ -88,7 +95,7 @@ impl TierString {
                 (string.nut_force_change_n(), string.bridge_force_change_n())
             }
         };
-        nut_weight * nut + (1.0 - nut_weight) * bridge
+        weighted_pickup_n(nut_weight, nut, bridge)
     }
 
     /// The string's physical constants as configured (the tuned tension included).

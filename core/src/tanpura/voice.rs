@@ -578,9 +578,9 @@ impl TanpuraVoice {
     /// call ([`ModalString::step_into`]: one dispatch to the vector unit for the run, not one a
     /// sample).
     pub fn process(&mut self, output: &mut [f32]) {
+        let nut_weight = self.settings.nut_pickup_weight;
         let mut done = 0;
         while done < output.len() {
-            let nut_weight = self.settings.nut_pickup_weight;
             let until_check = SLEEP_CHECK_INTERVAL.saturating_sub(self.samples_since_sleep_check);
             let sleeping = self.sleeping;
             if let (false, TierString::Modal(string)) = (sleeping, self.string_mut()) {

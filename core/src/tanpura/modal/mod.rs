@@ -42,6 +42,7 @@ use crate::simd::CacheAligned;
 use crate::tanpura::excitation::{finger_height_m, Pluck};
 use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
 use crate::tanpura::string::StringParameters;
+use crate::tanpura::tier_string::weighted_pickup_n;
 use lanes::{padded_lanes, AdvanceAndPrepare, Dots, Kernels, LeadingDots, Real, LANE_PADDING};
 use modes::{ModeSet, AUDIBLE_LIMIT_HZ, MODE_CAPACITY};
 use points::{grid_points, ContactPoints};
@@ -462,8 +463,8 @@ impl<T: Real> ModalString<T> {
     }
 
     /// [`ModalString::step`] once per element of `output`, writing each step's pickup signal
-    /// `w ΔF_nut + (1 − w) ΔF_bridge` (`w = nut_weight`, N) as f32: one dispatch to the vector
-    /// unit for the whole run.
+    /// ([`weighted_pickup_n`] with `nut_weight`, N) as f32: one dispatch to the vector unit for
+    /// the whole run.
     pub fn step_into(&mut self, output: &mut [f32], nut_weight: f64) {
         let kernels = self.kernels;
         kernels.arch.dispatch(StepRun {
@@ -916,8 +917,11 @@ impl<T: Real> WithSimd for StepRun<'_, T> {
         let (string, weight) = (self.string, self.nut_weight);
         for sample in self.output {
             string.step_on(simd);
-            let pickup =
-                weight * string.nut_force_change_n + (1.0 - weight) * string.bridge_force_change_n;
+            let pickup = weighted_pickup_n(
+                weight,
+                string.nut_force_change_n,
+                string.bridge_force_change_n,
+            );
             *sample = pickup as f32;
         }
     }

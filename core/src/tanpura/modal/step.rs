@@ -44,7 +44,7 @@ use super::points::ContactPoints;
 use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
 use crate::newton::NewtonSettings;
 use crate::tanpura::contact::HuntCrossley;
-use pulp::{Simd, WithSimd};
+use pulp::Simd;
 
 /// The slot of a point that is not tracked.
 const UNTRACKED: usize = usize::MAX;
@@ -107,6 +107,7 @@ pub struct ContactStep {
     block_lanes: Block<BLOCK>,
     wide_block_lanes: Box<Block<WIDE_BLOCK>>,
     /// Whether every solve takes the general path (for the test that the two agree).
+    #[cfg(test)]
     general_path_only: bool,
     residual: Vec<f64>,
     /// The slots with c > 0 at the last evaluation and their √c.
@@ -135,42 +136,6 @@ pub struct ContactOutcome {
     pub damping_loss_j: f64,
     /// The deepest penetration of the tracked points after the step (0 if none), m.
     pub penetration_m: f64,
-}
-
-/// The contact work of one step ([`ContactStep::step`]), compiled for the machine's vector unit
-/// with the rest of the step: every method it calls is inlined into it, so its scalar
-/// arithmetic uses the unit's VEX encoding and its passes over all points run in the unit's full
-/// width.
-struct ContactPass<'a> {
-    contact: &'a mut ContactStep,
-    points: &'a ContactPoints,
-    settings: &'a NewtonSettings,
-    track_energy: bool,
-    band_m: f64,
-    release_m: f64,
-}
-
-impl WithSimd for ContactPass<'_> {
-    type Output = ContactOutcome;
-
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, _simd: S) -> ContactOutcome {
-        let contact = self.contact;
-        let (iterations, converged) = contact.solve(self.points, self.settings, self.band_m);
-        let damping_loss_j = if self.track_energy {
-            contact.damping_loss_j()
-        } else {
-            0.0
-        };
-        let penetration_m = contact.finish_step(self.points);
-        contact.update_tracking(self.points, self.band_m, self.release_m);
-        ContactOutcome {
-            iterations,
-            converged,
-            damping_loss_j,
-            penetration_m,
-        }
-    }
 }
 
 /// The per-point arrays of [`far_points_after_step`].
@@ -258,6 +223,7 @@ impl ContactStep {
             block: vec![0.0; slot_stride * slot_stride],
             block_lanes: [[0.0; BLOCK]; BLOCK],
             wide_block_lanes: Box::new([[0.0; WIDE_BLOCK]; WIDE_BLOCK]),
+            #[cfg(test)]
             general_path_only: false,
             residual: slot_zeros(),
             active: vec![0; slot_stride],
@@ -345,22 +311,13 @@ impl ContactStep {
     /// Tracks the points whose gap lies within `band_m` of contact or that carry a force at rest,
     /// from scratch. Every gap in `gaps_m` must be exact on entry. Forgets the initial guesses.
     pub fn classify(&mut self, points: &ContactPoints, band_m: f64) {
+        // Every slot becomes neutral again (the slots past the tracked ones already are).
         for slot in 0..self.count {
             self.slots[self.tracked[slot]] = UNTRACKED;
+            self.clear_slot(slot);
+            self.copy_block_lanes(slot);
         }
         self.count = 0;
-        for values in [
-            &mut self.gaps,
-            &mut self.free_steps,
-            &mut self.steps,
-            &mut self.corrections,
-            &mut self.rest_forces,
-            &mut self.block,
-        ] {
-            values.fill(0.0);
-        }
-        self.block_lanes = [[0.0; BLOCK]; BLOCK];
-        *self.wide_block_lanes = [[0.0; WIDE_BLOCK]; WIDE_BLOCK];
         self.awake_count = points.len();
         for i in 0..points.len() {
             self.awake[i] = 1.0;
@@ -481,29 +438,35 @@ impl ContactStep {
         }
     }
 
-    /// One step's contact work on the vector unit `simd` (inlined into the modal string's step,
-    /// which runs as one function compiled for it): [`ContactStep::solve`], the damping loss
+    /// One step's contact work, inlined into the modal string's step, which runs as one function
+    /// compiled for the vector unit `simd` (so its scalar arithmetic uses the unit's encoding and
+    /// its passes over all points the unit's full width): [`ContactStep::solve`], the damping loss
     /// (with `track_energy`), [`ContactStep::finish_step`] and [`ContactStep::update_tracking`]
     /// with `band_m` and `release_m`.
     #[inline(always)]
     pub(super) fn step<S: Simd>(
         &mut self,
-        simd: S,
+        _simd: S,
         points: &ContactPoints,
         settings: &NewtonSettings,
         track_energy: bool,
         band_m: f64,
         release_m: f64,
     ) -> ContactOutcome {
-        ContactPass {
-            contact: self,
-            points,
-            settings,
-            track_energy,
-            band_m,
-            release_m,
+        let (iterations, converged) = self.solve(points, settings, band_m);
+        let damping_loss_j = if track_energy {
+            self.damping_loss_j()
+        } else {
+            0.0
+        };
+        let penetration_m = self.finish_step(points);
+        self.update_tracking(points, band_m, release_m);
+        ContactOutcome {
+            iterations,
+            converged,
+            damping_loss_j,
+            penetration_m,
         }
-        .with_simd(simd)
     }
 
     /// Solves the step's contact (every point's free step must be in place, from
@@ -549,7 +512,8 @@ impl ContactStep {
     #[inline(always)]
     fn solve_tracked(&mut self, settings: &NewtonSettings) -> (u32, Option<bool>) {
         let (tolerance, cap) = (settings.tolerance_m, settings.max_iterations);
-        if self.count <= BLOCK && !self.general_path_only {
+        let lanes_allowed = self.fixed_lanes_allowed();
+        if self.count <= BLOCK && lanes_allowed {
             let mut state = self.block_state::<BLOCK>();
             if state.free_of_contact() {
                 return self.settle_free::<BLOCK>();
@@ -557,7 +521,7 @@ impl ContactStep {
             let outcome = state.newton(&self.block_lanes, tolerance, cap);
             return self.take_block_solution(&state, outcome);
         }
-        if self.count <= WIDE_BLOCK && !self.general_path_only {
+        if self.count <= WIDE_BLOCK && lanes_allowed {
             let mut state = self.block_state::<WIDE_BLOCK>();
             if state.free_of_contact() {
                 return self.settle_free::<WIDE_BLOCK>();
@@ -634,6 +598,16 @@ impl ContactStep {
     #[cfg(test)]
     pub(super) fn take_general_path_only(&mut self) {
         self.general_path_only = true;
+    }
+
+    /// Whether the solve may run in fixed lanes: always, outside the test that compares the
+    /// paths.
+    #[inline(always)]
+    fn fixed_lanes_allowed(&self) -> bool {
+        #[cfg(test)]
+        return !self.general_path_only;
+        #[cfg(not(test))]
+        true
     }
 
     /// Forms every point's `Σ_j G_ij ΔF_j` at the current forces; a far point whose step
