@@ -276,6 +276,99 @@ impl ContactCondensation {
     /// `S' + I* C I`, solves and applies the update to `step` on the block. Returns ‖δ‖∞, or
     /// None when the Jacobian is not positive definite.
     pub fn update(&mut self, step: &mut [f64], contact: &[f64]) -> Option<f64> {
+        match self.active_size {
+            4 => self.update_fixed::<4>(step, contact),
+            5 => self.update_fixed::<5>(step, contact),
+            6 => self.update_fixed::<6>(step, contact),
+            7 => self.update_fixed::<7>(step, contact),
+            8 => self.update_fixed::<8>(step, contact),
+            _ => self.update_any_size(step, contact),
+        }
+    }
+
+    /// [`ContactCondensation::update`] for an active block of `M` nodes (the common sizes at
+    /// the seed's grid: 5 to 8), in fixed-size arrays, so that the loops unroll and the factors
+    /// stay in registers. The same operations in the same order as the any-size path.
+    #[inline(always)]
+    fn update_fixed<const M: usize>(&mut self, step: &mut [f64], contact: &[f64]) -> Option<f64> {
+        let first = self.active_first;
+        let offset = first - self.first_node;
+        let mut schur = [[0.0; M]; M];
+        for (row, source) in schur
+            .iter_mut()
+            .zip(self.active_schur[..M * M].chunks_exact(M))
+        {
+            row.copy_from_slice(source);
+        }
+        let mut jacobian = schur;
+        for (row, entries) in self.band[..M].iter().enumerate() {
+            for (k, value) in entries.iter().enumerate().take(row + 1) {
+                jacobian[row][row - k] += value;
+            }
+        }
+        let block_step: &mut [f64; M] = (&mut step[first..first + M]).try_into().ok()?;
+        let predictor: &[f64; M] = self.predictor[offset..offset + M].try_into().ok()?;
+        let forces: &[f64; M] = contact[first..first + M].try_into().ok()?;
+        // R = S' (s − s_lin) − f on the block.
+        let mut difference = [0.0; M];
+        for ((d, s), p) in difference.iter_mut().zip(&*block_step).zip(predictor) {
+            *d = s - p;
+        }
+        let mut solution = [0.0; M];
+        for ((x, row), force) in solution.iter_mut().zip(&schur).zip(forces) {
+            let mut product = 0.0;
+            for (a, b) in row.iter().zip(&difference) {
+                product += a * b;
+            }
+            *x = product - force;
+        }
+        // LDLᵀ in place (as `ldlt_in_place`: L below the diagonal, 1/D on it), then the solve.
+        for i in 0..M {
+            let mut u = [0.0; M];
+            for j in 0..i {
+                let mut dot = 0.0;
+                for k in 0..j {
+                    dot += u[k] * jacobian[j][k];
+                }
+                u[j] = jacobian[i][j] - dot;
+            }
+            let mut diagonal = jacobian[i][i];
+            for j in 0..i {
+                let l = u[j] * jacobian[j][j];
+                jacobian[i][j] = l;
+                diagonal -= u[j] * l;
+            }
+            if diagonal.is_nan() || diagonal <= 0.0 {
+                return None;
+            }
+            jacobian[i][i] = 1.0 / diagonal;
+        }
+        for i in 0..M {
+            let mut dot = 0.0;
+            for j in 0..i {
+                dot += jacobian[i][j] * solution[j];
+            }
+            solution[i] -= dot;
+        }
+        for (i, x) in solution.iter_mut().enumerate() {
+            *x *= jacobian[i][i];
+        }
+        for i in (0..M).rev() {
+            let x = solution[i];
+            for j in 0..i {
+                solution[j] -= jacobian[i][j] * x;
+            }
+        }
+        let mut largest = 0.0f64;
+        for (s, delta) in block_step.iter_mut().zip(&solution) {
+            *s -= delta;
+            largest = largest.max(delta.abs());
+        }
+        Some(largest)
+    }
+
+    /// [`ContactCondensation::update`] for any block size.
+    fn update_any_size(&mut self, step: &mut [f64], contact: &[f64]) -> Option<f64> {
         let size = self.active_size;
         let first = self.active_first;
         let offset = first - self.first_node;
@@ -429,6 +522,61 @@ mod tests {
         for i in 0..unknowns {
             assert!((step[i + 1] - with_force[i]).abs() < 1e-12);
         }
+    }
+
+    /// The fixed-size updates (blocks of 4 to 8 nodes) against the any-size update, bit for bit,
+    /// for every block size from 1 to 12 and every position of the block in C.
+    #[test]
+    fn fixed_size_updates_equal_the_any_size_update() {
+        let unknowns = 16;
+        let mut a = SymmetricBanded::zeros(unknowns, 2);
+        for row in 0..unknowns {
+            a.set(row, row, 6.0 + 0.1 * row as f64);
+            if row >= 1 {
+                a.set(row, row - 1, -2.0);
+            }
+            if row >= 2 {
+                a.set(row, row - 2, 0.5);
+            }
+        }
+        let mut factor = BandedLdlt::with_shape(unknowns, 2);
+        factor.factorise(&a).unwrap();
+        let (first_node, last_node) = (2, 13);
+        let mut condensation = ContactCondensation::new(first_node, last_node, unknowns);
+        let mut scratch = vec![0.0; unknowns];
+        condensation.prepare(&factor, &mut scratch).unwrap();
+        let predictor: Vec<f64> = (0..unknowns + 2).map(|i| (0.7 * i as f64).sin()).collect();
+        condensation.set_predictor(&predictor);
+        let mut checked_fixed = 0;
+        for size in 1..=12 {
+            for first in first_node..=last_node + 1 - size {
+                assert!(condensation.set_active_block(first, first + size - 1));
+                let (band, _, _) = condensation.contact_band_reset();
+                for (row, entries) in band.iter_mut().enumerate() {
+                    for (k, value) in entries.iter_mut().enumerate() {
+                        *value = 0.3 + 0.05 * (row + k) as f64 * if k == 0 { 1.0 } else { -0.2 };
+                    }
+                }
+                let contact: Vec<f64> = (0..unknowns + 2).map(|i| (1.3 * i as f64).cos()).collect();
+                let start: Vec<f64> = (0..unknowns + 2)
+                    .map(|i| predictor[i] + 0.01 * (0.4 * i as f64).cos())
+                    .collect();
+                let (mut dispatched, mut general) = (start.clone(), start);
+                let a = condensation.update(&mut dispatched, &contact);
+                let b = condensation.update_any_size(&mut general, &contact);
+                assert_eq!(
+                    a.map(f64::to_bits),
+                    b.map(f64::to_bits),
+                    "size {size}, first {first}"
+                );
+                assert!(a.is_some());
+                for (x, y) in dispatched.iter().zip(&general) {
+                    assert_eq!(x.to_bits(), y.to_bits(), "size {size}, first {first}");
+                }
+                checked_fixed += (4..=8).contains(&size) as usize;
+            }
+        }
+        assert!(checked_fixed > 0);
     }
 
     #[test]
