@@ -53,6 +53,9 @@ pub struct NewtonStats {
     pub cap_hits: u64,
     /// Updates made in the last step.
     pub last_iterations: u32,
+    /// Steps whose condensed solve was redone with every barrier point, because the accepted
+    /// step reached farther than the candidate margin (`fd/mod.rs`).
+    pub redone_steps: u64,
 }
 
 impl NewtonStats {
@@ -64,6 +67,7 @@ impl NewtonStats {
         max_iterations: 0,
         cap_hits: 0,
         last_iterations: 0,
+        redone_steps: 0,
     };
 
     /// Mean Newton updates per time step.
@@ -97,6 +101,7 @@ impl NewtonStats {
         self.max_iterations = self.max_iterations.max(other.max_iterations);
         self.cap_hits += other.cap_hits;
         self.last_iterations = self.last_iterations.max(other.last_iterations);
+        self.redone_steps += other.redone_steps;
     }
 }
 

@@ -258,9 +258,16 @@ impl ContactCondensation {
         }
     }
 
-    /// The largest |s_lin| on C, m.
-    pub fn predictor_max_abs(&self) -> f64 {
-        self.predictor.iter().fold(0.0, |a, s| a.max(s.abs()))
+    /// The largest |s| on C of Newton's initial guess (`s_lin` plus the extrapolated
+    /// correction, as [`ContactCondensation::apply_initial_guess`] forms it on the block), m.
+    pub fn guess_max_abs(&self) -> f64 {
+        self.predictor
+            .iter()
+            .zip(&self.previous_correction)
+            .zip(&self.older_correction)
+            .fold(0.0, |largest, ((p, c), o)| {
+                largest.max((p + (2.0 * c - o)).abs())
+            })
     }
 
     /// The contact Jacobian band of the active block, zeroed, for barriers to add their
