@@ -700,8 +700,8 @@ impl FdString {
         // iteration; the bound is checked on the accepted step. The margin is twice what
         // Newton's initial guess reaches (the predictor plus the extrapolated contact
         // correction): the accepted step lies close to the guess, and the contact holds it far
-        // below the contact-free predictor (after the default pluck at the reference grid,
-        // 23 candidates instead of 43 with the predictor's reach, no step redone).
+        // below the contact-free predictor (after the default pluck at the reference grid, no
+        // step is redone: test `condensed_candidate_margin_rarely_redoes_a_step`).
         let condensed = solver.kind == SolverKind::Condensed && solver.condensation.is_some();
         let lebesgue = solver
             .bridge
