@@ -290,46 +290,62 @@ fn non_finite_and_out_of_range_values_are_clamped() {
     }
 }
 
-/// The latency a host is told: the same at every tier and for both instruments (the FD tiers'
-/// decimator delay, whole samples), so a change of tier never changes it; a modal tier's string
-/// is delayed to match: its output is exactly silent for that many samples after its pluck, and
-/// sounds from the next.
+/// The latency a host is told follows the tier: the FD tiers' decimator delay (whole samples)
+/// at studio and reference, none at the modal tiers and for the bowed string. An engine reports
+/// the latency it was built with until it adopts the tier's (the plugin does at activation), and
+/// a voice with less latency of its own is delayed to it: a modal string plucked while an FD
+/// latency is reported is exactly silent for that many samples and sounds from the next, and
+/// sounds from its first sample once the engine has adopted the modal tier's latency.
 #[test]
-fn latency_is_the_same_at_every_tier_and_the_modal_tiers_are_delayed_to_it() {
-    let tanpura_settings = settings(Instrument::Tanpura);
-    let mut settings = tanpura_settings;
-    let mut engine = Engine::new(&settings, 44_100.0, 2);
-    let mut latency = |quality: Quality, instrument: Instrument| {
+fn latency_follows_the_tier_and_lower_latency_voices_are_delayed_to_it() {
+    let tanpura = settings(Instrument::Tanpura);
+    let at = |quality: Quality, instrument: Instrument| {
+        let mut settings = tanpura;
         settings.voice.quality = quality;
         settings.instrument = instrument;
-        engine.set_settings(&settings);
-        engine.latency_samples()
+        settings
     };
-    let reference = latency(Quality::Reference, Instrument::Tanpura);
-    println!("latency: {reference} samples at every tier");
-    assert!(reference > 1.0 && reference < 64.0, "{reference}");
-    assert_eq!(reference.fract(), 0.0);
+    let fd_latency =
+        Engine::new(&at(Quality::Reference, Instrument::Tanpura), 44_100.0, 1).latency_samples();
+    println!("latency: {fd_latency} samples at the FD tiers");
+    assert!(fd_latency > 1.0 && fd_latency < 64.0, "{fd_latency}");
+    assert_eq!(fd_latency.fract(), 0.0);
     for quality in Quality::ALL {
-        assert_eq!(
-            latency(quality, Instrument::Tanpura),
-            reference,
-            "{quality:?}"
-        );
-        assert_eq!(
-            latency(quality, Instrument::Bowed),
-            reference,
-            "{quality:?}"
-        );
+        let expected = if quality.oversample() > 1 {
+            fd_latency
+        } else {
+            0.0
+        };
+        let engine = Engine::new(&at(quality, Instrument::Tanpura), 44_100.0, 1);
+        assert_eq!(engine.latency_samples(), expected, "{quality:?}");
+        assert_eq!(engine.tier_latency_samples(), expected, "{quality:?}");
+        let bowed = Engine::new(&at(quality, Instrument::Bowed), 44_100.0, 1);
+        assert_eq!(bowed.latency_samples(), 0.0, "{quality:?}, bowed");
     }
-    let delay = reference as usize;
-    for quality in [Quality::Draft, Quality::Live] {
-        let mut modal = tanpura_settings;
-        modal.voice.quality = quality;
-        let mut engine = Engine::new(&modal, 44_100.0, 1);
-        let mut output = vec![0.0f32; 256];
-        let pluck = [TimedEvent::note_on(0, 57, 1.0)];
-        engine.process(&pluck, &mut output);
-        assert!(output[..delay].iter().all(|&x| x == 0.0), "{quality:?}");
-        assert!(output[delay] != 0.0, "{quality:?}: silent after the delay");
-    }
+    // A change of tier is reported only once adopted.
+    let mut engine = Engine::new(&at(Quality::Reference, Instrument::Tanpura), 44_100.0, 1);
+    engine.set_settings(&at(Quality::Live, Instrument::Tanpura));
+    assert_eq!(engine.latency_samples(), fd_latency);
+    assert_eq!(engine.tier_latency_samples(), 0.0);
+    let delay = fd_latency as usize;
+    let pluck = [TimedEvent::note_on(0, 57, 1.0)];
+    let mut output = vec![0.0f32; 256];
+    engine.process(&pluck, &mut output);
+    assert!(
+        output[..delay].iter().all(|&x| x == 0.0),
+        "delayed to the FD latency"
+    );
+    assert!(output[delay] != 0.0, "silent after the delay");
+    engine.adopt_tier_latency();
+    assert_eq!(engine.latency_samples(), 0.0);
+    engine.reset();
+    engine.process(&pluck, &mut output);
+    assert!(
+        output[0] != 0.0,
+        "a modal string at the modal latency sounds at once"
+    );
+    engine.set_settings(&at(Quality::Studio, Instrument::Tanpura));
+    assert_eq!(engine.tier_latency_samples(), fd_latency);
+    engine.adopt_tier_latency();
+    assert_eq!(engine.latency_samples(), fd_latency);
 }

@@ -15,12 +15,16 @@
 //! (`javari_core::bowed::instrument` documents that mapping): CCs, channel and per-note pressure
 //! and pitch bend reach it too.
 //!
-//! Towards the host: one latency at every quality tier and for both instruments (the FD tiers'
-//! decimator delay, 29 samples; the engine delays the modal tiers and the bowed string to
-//! match, `Engine::latency_samples`), reported at activation and never changed, so switching
-//! tiers needs no restart (and nice-plug 0.4.2's CLAP wrapper never gets the chance to call
-//! `latency.changed` outside `activate`, which clap-validator caught); a state blob is repaired
-//! before it loads ([`state`]);
+//! Towards the host: the latency of the quality tier in use (the FD tiers' decimator delay, 29
+//! samples at 44.1 kHz; none for the modal tiers and the bowed string), set at activation
+//! (`Engine::adopt_tier_latency`). When the tier changes while the plugin is active, `process`
+//! asks the host to restart it once, and the next activation reports the new latency: CLAP
+//! through `request_restart`, then `latency.changed` inside `activate` (never from the audio
+//! thread's change itself: nice-plug 0.4.2 would call it after a deactivation that raced it,
+//! outside `activate`, which the CLAP spec forbids); VST3 through
+//! `restartComponent(kLatencyChanged)`. Until the restart, a string keeps sounding at the latency
+//! reported (a modal string plucked at an FD latency is delayed to it). A state blob is
+//! repaired before it loads ([`state`]);
 //! `process` runs with subnormals flushed to zero (`javari_core::denormals`).
 //!
 //! Each string is tuned by its sustained pitch as played once [`tuning_worker`] has measured
@@ -126,6 +130,9 @@ pub struct Javari {
     editor_state: Arc<editor::EguiEditorState>,
     /// Measures the strings' as-played tuning off the audio thread; started in `activate`.
     tuning: Option<TuningWorker>,
+    /// Whether `process` has asked the host for a restart since the last activation (the
+    /// tier's latency differs from the reported one).
+    restart_requested: bool,
 }
 
 impl Default for Javari {
@@ -140,6 +147,7 @@ impl Default for Javari {
             snapshots: SnapshotPublisher::new(SnapshotChannel::new(QUEUE_FRAMES)),
             editor_state: editor::default_state(),
             tuning: None,
+            restart_requested: false,
         }
     }
 }
@@ -189,14 +197,16 @@ impl Plugin for Javari {
     ) -> bool {
         let settings = self.params.engine_settings(&self.factory);
         let rate = f64::from(buffer_config.sample_rate);
-        let engine = match self.engine.take() {
+        let mut engine = match self.engine.take() {
             Some(mut engine) if engine.sample_rate_hz() == rate => {
                 engine.set_settings(&settings);
                 engine
             }
             _ => Engine::new(&settings, rate, DEFAULT_VOICE_COUNT),
         };
+        engine.adopt_tier_latency();
         context.set_latency_samples(latency_in_samples(&engine));
+        self.restart_requested = false;
         self.engine = Some(engine);
         if self.tuning.is_none() {
             self.tuning = Some(TuningWorker::start());
@@ -229,6 +239,16 @@ impl Plugin for Javari {
             return ProcessStatus::Error("process called before activate");
         };
         engine.set_settings(&self.params.engine_settings(&self.factory));
+        let tier_latency = engine.tier_latency_samples().round() as u32;
+        if tier_latency != latency_in_samples(engine) && !self.restart_requested {
+            // The tier's latency is adopted at the next activation; ask the host for one.
+            self.restart_requested = true;
+            match context.plugin_api() {
+                // kLatencyChanged: the host reads the new latency and restarts the plugin.
+                PluginApi::Vst3 => context.set_latency_samples(tier_latency),
+                _ => context.request_restart(),
+            }
+        }
         engine.set_host_tempo(context.transport().tempo);
 
         self.events.clear();

@@ -27,13 +27,15 @@
 //! - the boundary with the host: settings pass through [`EngineSettings::clamped`] and events
 //!   through [`EngineEvent::sanitised`], so a non-finite or out-of-range value from automation
 //!   or MIDI is clamped (NaN takes the default) before it reaches a string;
-//! - the output latency a host must compensate ([`Engine::latency_samples`]): the same at every
-//!   tier and for both instruments, the FD tiers' decimator delay (29 samples), with the modal
-//!   tiers' strings and the bowed string delayed to match ([`OutputDelay`]). A latency that
-//!   followed the tier would make the host restart the plugin at every switch, and nice-plug
-//!   0.4.2's CLAP wrapper reports a change that reaches it just after the host deactivated the
-//!   plugin with `latency.changed` outside `activate`, which the CLAP spec forbids
-//!   (clap-validator's parameter tests failed on it); 0.66 ms for the modal tiers buys neither.
+//! - the output latency a host must compensate ([`Engine::latency_samples`]): the latency of the
+//!   tier in use, the FD tiers' decimator delay (29 samples at 44.1 kHz) or none for the modal
+//!   tiers and the bowed string. It is fixed when the engine is built and when the plugin adopts
+//!   the tier's latency at activation ([`Engine::adopt_tier_latency`]); a change of tier
+//!   between two activations applies to each string from its next pluck, and the plugin asks
+//!   the host to restart it so that the reported latency follows ([`Engine::tier_latency_samples`]
+//!   says what it will be). A voice whose own latency is lower than the reported one is delayed
+//!   to match ([`OutputDelay`]); one whose latency is higher (an FD string still ringing after a
+//!   switch to a modal tier, until the host restarts the plugin) sounds that much late.
 //!
 //! Lifecycle (design.md): [`Engine::new`] allocates every voice; [`Engine::process`],
 //! [`Engine::set_settings`], [`Engine::set_host_tempo`] and [`Engine::reset`] never allocate,
@@ -52,7 +54,6 @@ use crate::bowed::{BowedEvent, BowedInstrument, BowedPlayerSettings, StringConst
 use crate::tanpura::as_played::{AsPlayedTuning, Calibration, CalibrationRequest, NOTE_VELOCITIES};
 use crate::tanpura::body::{Body, TANPURA_BODY};
 use crate::tanpura::excitation::Pluck;
-use crate::tanpura::quality::Quality;
 use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
 use drone::{string_ratios, DroneSequencer, DroneSettings};
 use smoothing::Ramp;
@@ -68,7 +69,7 @@ pub const NEWTONS_AT_FULL_SCALE: f64 = 2.0;
 const MAX_OUTPUT_DELAY: usize = 64;
 
 /// A fixed delay of up to [`MAX_OUTPUT_DELAY`] samples (a ring buffer), to bring a voice whose
-/// own latency is lower up to the engine's uniform latency. Allocation-free.
+/// own latency is lower up to the engine's reported latency. Allocation-free.
 #[derive(Debug, Clone)]
 struct OutputDelay {
     buffer: [f32; MAX_OUTPUT_DELAY],
@@ -107,6 +108,18 @@ impl OutputDelay {
         }
         delayed
     }
+}
+
+/// The latency `settings` ask for, whole samples at the output rate: the tanpura's tier's own
+/// (the FD tiers' decimator delay, none for the modal tiers), none for the bowed string.
+fn tier_latency(slots: &[Slot], settings: &EngineSettings) -> usize {
+    if settings.instrument == Instrument::Bowed {
+        return 0;
+    }
+    let latency = slots.first().map_or(0.0, |slot| {
+        slot.voice.latency_samples_at(settings.voice.quality)
+    });
+    (latency.round() as usize).min(MAX_OUTPUT_DELAY)
 }
 
 /// Samples between two updates of the strings' smoothed settings.
@@ -638,14 +651,7 @@ impl Engine {
             (SMOOTHING_TIME_S * sample_rate_hz / CONTROL_INTERVAL as f64).ceil() as u32;
         let gain_steps = (SMOOTHING_TIME_S * sample_rate_hz).ceil() as u32;
         let gain = db_to_amplitude(settings.output_gain_db);
-        // The largest latency of any tier: the FD tiers' decimator delay.
-        let latency = slots.first().map_or(0.0, |slot: &Slot| {
-            Quality::ALL
-                .iter()
-                .map(|&quality| slot.voice.latency_samples_at(quality))
-                .fold(0.0, f64::max)
-        });
-        let latency = (latency.round() as usize).min(MAX_OUTPUT_DELAY);
+        let latency = tier_latency(&slots, settings);
         let mut engine = Self {
             sample_rate_hz,
             slots,
@@ -808,11 +814,33 @@ impl Engine {
         &self.target
     }
 
-    /// The output latency, samples at the output rate: the same whatever the tier or the
-    /// instrument (the FD tiers' decimator delay, rounded to whole samples; the other voices are
-    /// delayed to match).
+    /// The output latency a host must compensate, samples at the output rate: the latency of the
+    /// tier the engine was built with or last adopted ([`Engine::adopt_tier_latency`]); voices
+    /// with less latency of their own are delayed to it.
     pub fn latency_samples(&self) -> f64 {
         self.latency as f64
+    }
+
+    /// The latency the current settings ask for: the FD tiers' decimator delay (whole samples)
+    /// for the tanpura at the studio and reference tiers, none for the modal tiers and the
+    /// bowed string. When it differs from [`Engine::latency_samples`], the plugin asks the host
+    /// for a restart and adopts it at the next activation.
+    pub fn tier_latency_samples(&self) -> f64 {
+        tier_latency(&self.slots, &self.target) as f64
+    }
+
+    /// Makes the tier's latency ([`Engine::tier_latency_samples`]) the reported one: every
+    /// voice's delay is set to make up the difference to its own latency, and cleared (the
+    /// plugin calls this at activation, where the host expects a discontinuity).
+    /// Allocation-free.
+    pub fn adopt_tier_latency(&mut self) {
+        self.latency = tier_latency(&self.slots, &self.target);
+        for slot in &mut self.slots {
+            let own_latency = slot.voice.latency_samples().round() as usize;
+            slot.delay
+                .set_length(self.latency.saturating_sub(own_latency));
+        }
+        self.bowed_delay.set_length(self.latency);
     }
 
     /// Adds a string's as-played calibration (measured off the audio thread with
