@@ -697,15 +697,20 @@ pub fn economy_markdown(rows: &[EconomyRow]) -> String {
 }
 
 fn machine_name() -> String {
-    let model = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|text| {
-            text.lines()
-                .find(|line| line.starts_with("model name"))
-                .and_then(|line| line.split(':').nth(1))
-                .map(|name| name.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let field = |key: &str| {
+        cpuinfo
+            .lines()
+            .find(|line| line.split(':').next().map(str::trim) == Some(key))
+            .and_then(|line| line.split(':').nth(1))
+            .map(|value| value.trim().to_string())
+    };
+    let mut model = field("model name").unwrap_or_else(|| "unknown CPU".into());
+    // Virtual machines often name only the vendor's line: the family and model tell its
+    // generations apart (AMD family 25 is Zen 3/4, 26 is Zen 5).
+    if let (Some(family), Some(number)) = (field("cpu family"), field("model")) {
+        model += &format!(" (family {family}, model {number})");
+    }
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     // The vector unit the modal tiers' kernels dispatched to at run time.
     let vector_unit = javari_core::tanpura::modal::lanes::Kernels::detect().name();
@@ -825,6 +830,17 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
         runs,
     } = args;
     let machine = machine_name();
+    // The output files' folders exist before the work starts, so a run never ends on a path
+    // it cannot write.
+    for path in std::iter::once(&markdown).chain(json.as_ref()) {
+        if let Some(parent) = path
+            .parent()
+            .filter(|parent| !parent.as_os_str().is_empty())
+        {
+            std::fs::create_dir_all(parent)
+                .map_err(|error| format!("cannot create `{}`: {error}", parent.display()))?;
+        }
+    }
     // The timing scenes run first, alone: the grid renders on every core.
     let (results, economy) = if grid_only {
         (Vec::new(), Vec::new())
