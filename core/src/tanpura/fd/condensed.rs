@@ -480,10 +480,8 @@ mod tests {
     use super::*;
     use crate::banded::SymmetricBanded;
 
-    #[test]
-    fn schur_complement_reproduces_the_full_solve() {
-        // A pentadiagonal SPD matrix on 12 unknowns (nodes 1..=12), C = nodes 4..=7.
-        let unknowns = 12;
+    /// A pentadiagonal SPD matrix on `unknowns` unknowns, factorised.
+    fn factorised_test_matrix(unknowns: usize) -> BandedLdlt {
         let mut a = SymmetricBanded::zeros(unknowns, 2);
         for row in 0..unknowns {
             a.set(row, row, 6.0 + 0.1 * row as f64);
@@ -496,6 +494,14 @@ mod tests {
         }
         let mut factor = BandedLdlt::with_shape(unknowns, 2);
         factor.factorise(&a).unwrap();
+        factor
+    }
+
+    #[test]
+    fn schur_complement_reproduces_the_full_solve() {
+        // A pentadiagonal SPD matrix on 12 unknowns (nodes 1..=12), C = nodes 4..=7.
+        let unknowns = 12;
+        let factor = factorised_test_matrix(unknowns);
         let mut condensation = ContactCondensation::new(4, 7, unknowns);
         let mut scratch = vec![0.0; unknowns];
         condensation.prepare(&factor, &mut scratch).unwrap();
@@ -536,18 +542,7 @@ mod tests {
     #[test]
     fn fixed_size_updates_equal_the_any_size_update() {
         let unknowns = 16;
-        let mut a = SymmetricBanded::zeros(unknowns, 2);
-        for row in 0..unknowns {
-            a.set(row, row, 6.0 + 0.1 * row as f64);
-            if row >= 1 {
-                a.set(row, row - 1, -2.0);
-            }
-            if row >= 2 {
-                a.set(row, row - 2, 0.5);
-            }
-        }
-        let mut factor = BandedLdlt::with_shape(unknowns, 2);
-        factor.factorise(&a).unwrap();
+        let factor = factorised_test_matrix(unknowns);
         let (first_node, last_node) = (2, 13);
         let mut condensation = ContactCondensation::new(first_node, last_node, unknowns);
         let mut scratch = vec![0.0; unknowns];
@@ -590,18 +585,7 @@ mod tests {
     fn sub_block_schur_complement_matches_forces_on_the_sub_block() {
         // The same matrix, C = nodes 3..=9, forces only on C' = nodes 5..=7.
         let unknowns = 12;
-        let mut a = SymmetricBanded::zeros(unknowns, 2);
-        for row in 0..unknowns {
-            a.set(row, row, 6.0 + 0.1 * row as f64);
-            if row >= 1 {
-                a.set(row, row - 1, -2.0);
-            }
-            if row >= 2 {
-                a.set(row, row - 2, 0.5);
-            }
-        }
-        let mut factor = BandedLdlt::with_shape(unknowns, 2);
-        factor.factorise(&a).unwrap();
+        let factor = factorised_test_matrix(unknowns);
         let mut condensation = ContactCondensation::new(3, 9, unknowns);
         let mut scratch = vec![0.0; unknowns];
         condensation.prepare(&factor, &mut scratch).unwrap();
