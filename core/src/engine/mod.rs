@@ -476,6 +476,13 @@ struct Slot {
     level: f32,
 }
 
+impl Slot {
+    /// The delay that brings this string's own latency (its tier's) up to `latency`.
+    fn padding_to(&self, latency: usize) -> usize {
+        latency.saturating_sub(self.voice.latency_samples().round() as usize)
+    }
+}
+
 /// Samples a voice renders at a time in [`run_slot`] (a stack buffer).
 const VOICE_RUN: usize = 64;
 
@@ -836,9 +843,7 @@ impl Engine {
     pub fn adopt_tier_latency(&mut self) {
         self.latency = tier_latency(&self.slots, &self.target);
         for slot in &mut self.slots {
-            let own_latency = slot.voice.latency_samples().round() as usize;
-            slot.delay
-                .set_length(self.latency.saturating_sub(own_latency));
+            slot.delay.set_length(slot.padding_to(self.latency));
         }
         self.bowed_delay.set_length(self.latency);
     }
@@ -1436,8 +1441,7 @@ impl Engine {
         slot.level_factor = slot.pitch_level * level;
         // Also brings a re-plucked string to the current quality tier.
         slot.voice.set_settings(&string_settings);
-        let own_latency = slot.voice.latency_samples().round() as usize;
-        let padding = self.latency.saturating_sub(own_latency);
+        let padding = slot.padding_to(self.latency);
         if slot.delay.length != padding {
             slot.delay.set_length(padding);
         }

@@ -205,7 +205,7 @@ impl ContactCondensation {
         for (s, ((predictor, correction), older)) in
             step[self.active_first..].iter_mut().zip(guesses)
         {
-            *s = predictor + (2.0 * correction - older);
+            *s = initial_guess(*predictor, *correction, *older);
         }
     }
 
@@ -266,7 +266,7 @@ impl ContactCondensation {
             .zip(&self.previous_correction)
             .zip(&self.older_correction)
             .fold(0.0, |largest, ((p, c), o)| {
-                largest.max((p + (2.0 * c - o)).abs())
+                largest.max(initial_guess(*p, *c, *o).abs())
             })
     }
 
@@ -423,6 +423,13 @@ impl ContactCondensation {
         }
         Some(largest)
     }
+}
+
+/// Newton's initial guess at one node: the predictor plus the contact correction extrapolated
+/// linearly from the last two accepted steps' (`2 c − c_older`).
+#[inline(always)]
+fn initial_guess(predictor: f64, correction: f64, older_correction: f64) -> f64 {
+    predictor + (2.0 * correction - older_correction)
 }
 
 /// Factorises the symmetric positive definite row-major `size × size` matrix (only its lower

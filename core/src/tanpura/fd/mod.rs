@@ -151,8 +151,6 @@ struct StepSolver {
     kind: SolverKind,
     /// The contact region's Schur complement (None when no barrier can ever touch).
     condensation: Option<ContactCondensation>,
-    /// Whether the last condensed solve was redone with every point (see `solve_condensed`).
-    redone_this_step: bool,
 }
 
 impl StepSolver {
@@ -182,7 +180,8 @@ impl StepSolver {
     /// in `step`, ending with the whole step in `step` and the forces of the accepted step in
     /// the barrier grids. Points farther from contact than `margin` were left out of the
     /// candidates; if the accepted step reaches that far (`lebesgue` bounds the interpolated
-    /// step), the solve is redone with every point. Returns (updates, converged).
+    /// step), the solve is redone with every point (counted in `stats.redone_steps`). Returns
+    /// (updates, converged).
     fn solve_condensed(
         &mut self,
         kernels: &Kernels,
@@ -190,9 +189,9 @@ impl StepSolver {
         settings: &NewtonSettings,
         mut margin: f64,
         lebesgue: f64,
+        stats: &mut NewtonStats,
     ) -> (u32, bool) {
         let mut outcome = (0, true);
-        self.redone_this_step = false;
         loop {
             let Some((first, last)) = self.candidate_node_range() else {
                 return outcome;
@@ -228,7 +227,7 @@ impl StepSolver {
                 return outcome;
             }
             // The step went farther than the candidate margin: redo with every point.
-            self.redone_this_step = true;
+            stats.redone_steps += 1;
             margin = f64::INFINITY;
             for barrier in [&mut self.bridge, &mut self.thread] {
                 if barrier.is_active() {
@@ -331,7 +330,6 @@ impl FdString {
             kind: config.solver,
             condensation: contact_node_range(&config, operator.spacing_m())
                 .map(|(first, last)| ContactCondensation::new(first, last, n - 1)),
-            redone_this_step: false,
         };
         let mut string = Self {
             config,
@@ -733,6 +731,7 @@ impl FdString {
                 &self.config.newton,
                 margin,
                 lebesgue,
+                &mut self.stats,
             )
         } else {
             let outcome = solve_bounded(solver, &self.config.newton);
@@ -745,9 +744,6 @@ impl FdString {
             outcome
         };
         self.stats.record(iterations, converged);
-        if condensed && touching && solver.redone_this_step {
-            self.stats.redone_steps += 1;
-        }
         self.touched_last_step = touching;
 
         if self.config.track_energy {
