@@ -42,6 +42,11 @@ pub struct BarrierGrid {
     weight_columns: [Vec<f64>; 4],
     segments: Vec<StencilSegment>,
     segment_count: usize,
+    /// Per segment, what bounds its points' gaps from above without visiting them
+    /// ([`SegmentBound`]), and the segments the current step visits.
+    segment_bounds: Vec<SegmentBound>,
+    near_segments: Vec<StencilSegment>,
+    near_segment_count: usize,
     kernels: Kernels,
     /// The free stencil: first node in `1..=N−4` and weights with fixed nodes zeroed.
     free_first_node: Vec<usize>,
@@ -72,6 +77,61 @@ fn step_at(weights: &[f64; 4], step: &[f64], first: usize) -> f64 {
 fn dot4(weights: &[f64; 4], values: &[f64]) -> f64 {
     let v = &values[..4];
     weights[0] * v[0] + weights[1] * v[1] + weights[2] * v[2] + weights[3] * v[3]
+}
+
+/// Added to a segment's gap bound before it is compared with the candidate margin: far above
+/// the round-off of the bound and of the gaps themselves (about 1e-19 m for millimetre
+/// displacements), far below any margin (`CANDIDATE_MARGIN_FLOOR_M`).
+const GAP_BOUND_SLACK_M: f64 = 1e-12;
+
+/// An upper bound on the gaps `a_i = h_i − Σ_j w_ij y_j` of a segment's points (one stencil,
+/// nodes `y_0..y_3`) from four node values. With `y_j = y_1 + d_j`,
+/// `Σ_j w_ij y_j = y_1 Σ_j w_ij + Σ_j w_ij d_j ≥ min(y_1 σ_min, y_1 σ_max) + Σ_j min(w_j,min d_j,
+/// w_j,max d_j)`, where `σ` is the weights' sum and `w_j,min`, `w_j,max` the extremes of column
+/// j over the segment; so `a_i ≤ h_max − that`. Relative to node 1 the terms are the string's
+/// local differences, so the bound is tight where the string is smooth.
+#[derive(Debug, Clone, Copy, Default)]
+struct SegmentBound {
+    height_max: f64,
+    sum_min: f64,
+    sum_max: f64,
+    weight_min: [f64; 4],
+    weight_max: [f64; 4],
+}
+
+impl SegmentBound {
+    fn of(heights: &[f64], weights: &[[f64; 4]]) -> Self {
+        let mut bound = Self {
+            height_max: f64::NEG_INFINITY,
+            sum_min: f64::INFINITY,
+            sum_max: f64::NEG_INFINITY,
+            weight_min: [f64::INFINITY; 4],
+            weight_max: [f64::NEG_INFINITY; 4],
+        };
+        for (height, w) in heights.iter().zip(weights) {
+            bound.height_max = bound.height_max.max(*height);
+            let sum: f64 = w.iter().sum();
+            bound.sum_min = bound.sum_min.min(sum);
+            bound.sum_max = bound.sum_max.max(sum);
+            for j in 0..4 {
+                bound.weight_min[j] = bound.weight_min[j].min(w[j]);
+                bound.weight_max[j] = bound.weight_max[j].max(w[j]);
+            }
+        }
+        bound
+    }
+
+    /// The bound on the segment's gaps for the stencil's node values `nodes` (four).
+    #[inline(always)]
+    fn largest_gap(&self, nodes: &[f64]) -> f64 {
+        let reference = nodes[1];
+        let mut lowest = (reference * self.sum_min).min(reference * self.sum_max);
+        for j in 0..4 {
+            let difference = nodes[j] - reference;
+            lowest += (self.weight_min[j] * difference).min(self.weight_max[j] * difference);
+        }
+        self.height_max - lowest
+    }
 }
 
 /// The stencil `first, weights` restricted to the free nodes `1..=N−1` of a string of
@@ -128,6 +188,9 @@ impl BarrierGrid {
             weight_columns: std::array::from_fn(|_| vec![0.0; capacity]),
             segments: vec![StencilSegment::default(); capacity],
             segment_count: 0,
+            segment_bounds: vec![SegmentBound::default(); capacity],
+            near_segments: vec![StencilSegment::default(); capacity],
+            near_segment_count: 0,
             kernels: Kernels::detect(),
             free_first_node: vec![1; capacity],
             free_weights: vec![[0.0; 4]; capacity],
@@ -197,6 +260,16 @@ impl BarrierGrid {
                     self.segment_count += 1;
                 }
             }
+        }
+        for (bound, segment) in self
+            .segment_bounds
+            .iter_mut()
+            .zip(&self.segments[..self.segment_count])
+        {
+            *bound = SegmentBound::of(
+                &self.heights_m[segment.start..segment.end],
+                &self.stencil_weights[segment.start..segment.end],
+            );
         }
     }
 
@@ -290,20 +363,36 @@ impl BarrierGrid {
     /// ([`BarrierGrid::candidate_node_range`]). The per-point results of the last evaluation
     /// are only meaningful for the candidates, and only after an evaluation.
     pub fn begin_step(&mut self, displacement: &[f64], margin_m: f64) {
-        let count = self.count;
+        // Segments whose gaps are all at most −margin (by their bound) hold no candidate: only
+        // the others are visited. The bound's slack is far above the gaps' round-off, so the
+        // candidates are exactly those of a pass over every point.
+        let mut near_count = 0;
+        for (segment, bound) in self.segments[..self.segment_count]
+            .iter()
+            .zip(&self.segment_bounds)
+        {
+            let nodes = &displacement[segment.first_node..segment.first_node + 4];
+            let far = bound.largest_gap(nodes) + GAP_BOUND_SLACK_M <= -margin_m;
+            self.near_segments[near_count] = *segment;
+            near_count += (!far) as usize;
+        }
+        self.near_segment_count = near_count;
         let [w0, w1, w2, w3] = &self.weight_columns;
+        let count = self.count;
         self.kernels.barrier_gaps(
             &self.heights_m[..count],
             [&w0[..count], &w1[..count], &w2[..count], &w3[..count]],
-            &self.segments[..self.segment_count],
+            &self.near_segments[..near_count],
             displacement,
             &mut self.gaps_m[..count],
         );
         let mut candidate_count = 0;
-        for (i, gap) in self.gaps_m[..count].iter().enumerate() {
-            // Branch-free compaction: the slot is written always, kept only for candidates.
-            self.candidates[candidate_count] = i;
-            candidate_count += (*gap > -margin_m) as usize;
+        for segment in &self.near_segments[..near_count] {
+            for (i, gap) in self.gaps_m[segment.start..segment.end].iter().enumerate() {
+                // Branch-free compaction: the slot is written always, kept only for candidates.
+                self.candidates[candidate_count] = segment.start + i;
+                candidate_count += (*gap > -margin_m) as usize;
+            }
         }
         self.candidate_count = candidate_count;
         // Points are in order along the string, so their free stencils are too.
@@ -576,6 +665,51 @@ mod tests {
                 "x = {x}"
             );
         }
+    }
+
+    /// The segments' gap bounds hold for every point, and the step's candidates are exactly
+    /// those of a pass over every point, while the far segments are skipped.
+    #[test]
+    fn far_segments_are_skipped_and_the_candidates_stay_the_same() {
+        let intervals = 40;
+        let dx = 0.005;
+        let mut grid = BarrierGrid::with_capacity(200, intervals);
+        // A curved barrier under the first part of the string, from the fixed end inwards.
+        grid.place(0.0007, 0.0009, 150, dx, |x| 1e-3 * (1.0 - 30.0 * x));
+        let mut skipped = 0;
+        for shape in 0..40 {
+            let phase = 0.37 * shape as f64;
+            let amplitude = 2e-4 * (1.0 + (1.3 * phase).sin());
+            let displacement: Vec<f64> = (0..=intervals)
+                .map(|m| {
+                    let x = m as f64 * dx;
+                    1e-3 * (1.0 - 30.0 * x) + amplitude * (40.0 * x + phase).sin() - 5e-5
+                })
+                .collect();
+            for margin in [1e-6, 2e-5, 3e-4] {
+                grid.begin_step(&displacement, margin);
+                let expected: Vec<usize> = (0..grid.len())
+                    .filter(|&i| grid.heights_m()[i] - grid.interpolate(&displacement, i) > -margin)
+                    .collect();
+                assert_eq!(
+                    grid.candidate_indices(),
+                    &expected[..],
+                    "shape {shape}, margin {margin}"
+                );
+                skipped += grid.segment_count - grid.near_segment_count;
+            }
+            for (segment, bound) in grid.segments[..grid.segment_count]
+                .iter()
+                .zip(&grid.segment_bounds)
+            {
+                let nodes = &displacement[segment.first_node..segment.first_node + 4];
+                for i in segment.start..segment.end {
+                    let gap = grid.heights_m()[i] - grid.interpolate(&displacement, i);
+                    assert!(gap <= bound.largest_gap(nodes) + 1e-18, "point {i}");
+                }
+            }
+        }
+        assert!(skipped > 0, "no segment was ever skipped");
     }
 
     #[test]
