@@ -15,11 +15,7 @@ const BLOCK: usize = 64;
 fn main() {
     let mut args = std::env::args().skip(1);
     let tier = args.next().unwrap_or_else(|| "reference".to_owned());
-    let quality = Quality::ALL
-        .iter()
-        .copied()
-        .find(|quality| quality.name() == tier)
-        .unwrap_or_else(|| panic!("unknown tier {tier}"));
+    let quality = Quality::from_name(&tier).unwrap_or_else(|| panic!("unknown tier {tier}"));
     let seconds: f64 = args.next().map_or(3.0, |s| s.parse().expect("seconds"));
     let runs: usize = args.next().map_or(5, |s| s.parse().expect("runs"));
     let settings = VoiceSettings {
