@@ -6,6 +6,9 @@
 //! square-root-free LDLᵀ factorisation without pivoting is exact and stable. No crate offers an
 //! allocation-free banded factorisation, hence this hand-written one (`design.md`).
 
+use crate::simd::Kernels;
+use pulp::{Simd, WithSimd};
+
 /// A symmetric `size × size` matrix whose entries vanish more than `half_bandwidth` off the
 /// diagonal. Storage: `band[row * (w + 1) + k] = A[row][row − k]` for `k = 0..=w`.
 #[derive(Debug, Clone, PartialEq)]
@@ -108,7 +111,7 @@ impl SymmetricBanded {
 
 /// The factors `L` (unit lower triangular, banded) and `D` (diagonal) of `A = L D Lᵀ`, stored in
 /// place of the band: `band[row][0] = D[row]`, `band[row][k] = L[row][row − k]`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct BandedLdlt {
     factors: SymmetricBanded,
     /// 1/D, so that solves multiply instead of divide.
@@ -125,6 +128,8 @@ pub struct BandedLdlt {
     /// before `e`. Empty when the matrix is too small to partition.
     forward_homogeneous: Vec<[f64; 2]>,
     backward_homogeneous: Vec<[f64; 2]>,
+    /// The vector unit the pentadiagonal solve is compiled for (see [`PentadiagonalSolve`]).
+    kernels: Kernels,
 }
 
 /// The pentadiagonal sweeps run as this many independent chains over consecutive blocks of
@@ -158,6 +163,7 @@ impl BandedLdlt {
             backward: vec![[0.0; 3]; pentadiagonal_size],
             forward_homogeneous: vec![[0.0; 2]; pentadiagonal_size],
             backward_homogeneous: vec![[0.0; 2]; pentadiagonal_size],
+            kernels: Kernels::detect(),
         }
     }
 
@@ -307,6 +313,15 @@ impl BandedLdlt {
     /// subtracts the older neighbour first, so that only one multiply and one subtraction wait
     /// for the previous row.
     fn solve_pentadiagonal(&self, solution: &mut [f64]) {
+        self.kernels.arch.dispatch(PentadiagonalSolve {
+            factor: self,
+            solution,
+        });
+    }
+
+    /// [`BandedLdlt::solve_pentadiagonal`] on the vector unit of the enclosing dispatch.
+    #[inline(always)]
+    fn solve_pentadiagonal_inlined(&self, solution: &mut [f64]) {
         match partition(self.factors.size) {
             Some((prefix, rows)) => self.solve_partitioned(prefix, rows, solution),
             None => self.solve_serial(solution),
@@ -314,6 +329,7 @@ impl BandedLdlt {
     }
 
     /// The two sweeps as one chain each (row after row).
+    #[inline(always)]
     fn solve_serial(&self, solution: &mut [f64]) {
         let size = self.factors.size;
         let solution = &mut solution[..size];
@@ -340,6 +356,7 @@ impl BandedLdlt {
     /// solutions run interleaved, four independent dependency chains instead of one four times as
     /// long; then the start values pass from block to block (two values each) and each block is
     /// fixed up in a pass with no chain. Same result as [`Self::solve_serial`] to round-off.
+    #[inline(always)]
     fn solve_partitioned(&self, prefix: usize, rows: usize, solution: &mut [f64]) {
         let size = self.factors.size;
         let solution = &mut solution[..size];
@@ -430,6 +447,25 @@ impl BandedLdlt {
                 *x += g * first + h * second;
             }
         }
+    }
+}
+
+/// The pentadiagonal solve compiled for the vector unit found at run time (AVX2 or AVX-512
+/// where present, `pulp`'s dispatch) instead of the generic x86-64 target's SSE2: the same
+/// operations in the same order (Rust never fuses a multiply and an add on its own), so the same
+/// result bit for bit. A `-C target-cpu=native` build showed where this pays: the solve took a
+/// fifth less time there; dispatched, the reference tier's step gained 2–5 %.
+struct PentadiagonalSolve<'a> {
+    factor: &'a BandedLdlt,
+    solution: &'a mut [f64],
+}
+
+impl WithSimd for PentadiagonalSolve<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) {
+        self.factor.solve_pentadiagonal_inlined(self.solution);
     }
 }
 
