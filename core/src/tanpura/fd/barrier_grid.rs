@@ -81,7 +81,7 @@ fn dot4(weights: &[f64; 4], values: &[f64]) -> f64 {
 
 /// Added to a segment's gap bound before it is compared with the candidate margin: far above
 /// the round-off of the bound and of the gaps themselves (about 1e-19 m for millimetre
-/// displacements), far below any margin (`CANDIDATE_MARGIN_FLOOR_M`).
+/// displacements). It only makes a segment count as near sooner, never skips a candidate.
 const GAP_BOUND_SLACK_M: f64 = 1e-12;
 
 /// An upper bound on the gaps `a_i = h_i − Σ_j w_ij y_j` of a segment's points (one stencil,
@@ -286,13 +286,6 @@ impl BarrierGrid {
     /// max_i Σ_j |w_ij| of the placed points (≥ 1; 1.25 at most for cubic Lagrange).
     pub fn lebesgue_constant(&self) -> f64 {
         self.lebesgue
-    }
-
-    /// Moves the whole barrier up by `offset_m` (a rigid finger rising). Allocation-free.
-    pub fn raise(&mut self, offset_m: f64) {
-        for height in &mut self.heights_m[..self.count] {
-            *height += offset_m;
-        }
     }
 
     /// Sets the contact law (k in N/m², r in s/m) for a scheme of step Δt and density ρA.

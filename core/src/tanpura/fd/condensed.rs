@@ -26,9 +26,10 @@
 //! response per contact node) recovers the whole step, `s = s_lin + Σ_j f_j A⁻¹ e_j`, over the
 //! nodes that carry a force: one banded solve per time step (the predictor) and no second one.
 //! `A` is banded and diagonally dominant, so each column decays geometrically away from its
-//! node; the recovery reads it only where it is above 2⁻⁶⁰ of its peak (at the reference grid
-//! 18–24 nodes either side of the contact node, of the string's 199), which leaves out less than
-//! the round-off of the correction ([`RESPONSE_CUTOFF`]).
+//! node; the recovery reads it only where it is above 2⁻⁶⁰ of its peak (on the seed's string 17
+//! nodes either side of the contact node, of 199; test
+//! `reference_grid_columns_are_significant_near_their_node_only`), which leaves out less than the
+//! round-off of the correction ([`RESPONSE_CUTOFF`]).
 //! Energy stability is untouched: the accepted `s` solves the same discrete equations (to the
 //! Newton tolerance), so the discrete energy balance of the full scheme holds as before. `G` and
 //! the influence columns depend only on `A`, so they are recomputed only when the string's
@@ -472,10 +473,10 @@ impl WithSimd for NewtonUpdate<'_> {
 
 /// Entries of an influence column `A⁻¹ e_j` below this fraction of the column's largest are
 /// left out of the recovery. The step matrix is banded and diagonally dominant, so its inverse
-/// decays geometrically away from the diagonal (at the reference grid by a factor of about 20
-/// per node): the column falls below 2⁻⁶⁰ within a dozen nodes of its contact node, and what is
-/// left out lies under the round-off (2⁻⁵³) of the correction at that node. The recovery then
-/// costs a few dozen nodes per forced node instead of the whole string.
+/// decays geometrically away from the diagonal: on the seed's string a column falls below 2⁻⁶⁰
+/// within 17 nodes of its contact node (a factor of about 11 per node), and what is left out
+/// lies under the round-off (2⁻⁵³) of the correction at that node. The recovery then costs a few
+/// dozen nodes per forced node instead of the whole string.
 const RESPONSE_CUTOFF: f64 = 1.0 / (1u64 << 60) as f64;
 
 /// The nodes `start..end` outside which `column`'s entries are at most [`RESPONSE_CUTOFF`]
@@ -552,6 +553,7 @@ fn ldlt_solve(factors: &[f64], size: usize, solution: &mut [f64]) {
 mod tests {
     use super::*;
     use crate::banded::SymmetricBanded;
+    use crate::tanpura::fd::{FdString, FdStringConfig};
 
     /// A pentadiagonal SPD matrix on `unknowns` unknowns, factorised.
     fn factorised_test_matrix(unknowns: usize) -> BandedLdlt {
@@ -647,6 +649,24 @@ mod tests {
             let error = (step[i + 1] - with_force[i]).abs();
             assert!(error <= 1e-15 * largest, "node {}: {error:e}", i + 1);
         }
+    }
+
+    /// At the seed's grid (the reference tier) each influence column is significant over a few
+    /// dozen nodes around its contact node, not over the string's 199: the figure the module
+    /// doc and `docs/performance.md` quote.
+    #[test]
+    fn reference_grid_columns_are_significant_near_their_node_only() {
+        let string = FdString::new(FdStringConfig::REFERENCE);
+        let condensation = string.solver.condensation.as_ref().expect("contact block");
+        let mut reaches = Vec::new();
+        for (j, &(start, end)) in condensation.response_support.iter().enumerate() {
+            let node = condensation.first_node + j;
+            assert!(start <= node && node < end, "column {j}: {start}..{end}");
+            reaches.push((node - start).max(end - 1 - node));
+        }
+        let (least, most) = (reaches.iter().min().unwrap(), reaches.iter().max().unwrap());
+        // 17 nodes on the seed's string.
+        assert!(*least >= 14 && *most <= 20, "reach {least}..={most} nodes");
     }
 
     /// The fixed-size updates (blocks of 4 to 8 nodes) against the any-size update, bit for bit,
