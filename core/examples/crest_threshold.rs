@@ -1,0 +1,256 @@
+//! Where the string starts to rest on the bridge's crest, and how a pluck there sounds, on the
+//! reference tier's grid and on finer ones: `cargo run --release -p javari-core --example
+//! crest_threshold` (about three minutes on two cores).
+//!
+//! The playing-range grid's worst plucks (README, issue 15) all lie at keys 48–54, where the
+//! reference tier's string at rest just touches the bridge's crest, 7 mm past the thread. Whether
+//! it touches, and whether a pluck lifts it off for the whole sustain window, is decided by
+//! fractions of a micrometre of static deflection. This example asks whether the reference's own
+//! grid resolves them, by the seed's physical parameters as they are (no tuning per scheme) at the
+//! tension of each key (the seed's tension scaled by (f_key / f_seed)², f_seed the reference grid's
+//! linearised fundamental):
+//!
+//! 1. At rest, the deepest bridge gap (positive: the string lies that far into the crest), µm: the
+//!    seed's FD grid (N = 200, the reference tier) and N = 400 and 800; the modal string at the live
+//!    tier's 1 mm bridge points with its kept modes only, with two residual modes, and with the
+//!    whole string's static compliance (the closed-form Green's function, `static_flexibility`), at
+//!    1 mm and at 0.25 mm points.
+//! 2. Plucked as the bench plucks, at MIDI velocities 40, 80 and 127: the sustained pitch
+//!    (0.3–1.5 s, the grid's measure) in cents from the same string's pitch at velocity 1 (its
+//!    small-amplitude pitch), on the FD scheme at N = 200 (4× oversampled, the reference), 400 (8×)
+//!    and 800 (16×), and on the modal scheme (f64) with two residual modes at 1 mm and 0.25 mm
+//!    points. A string that a pluck lifts off the crest sounds about 10 cents flat of its
+//!    small-amplitude pitch.
+//!
+//! The figures are quoted in `docs/modal-tanpura.md`, section 9; the static part is asserted by
+//! `core/tests/tanpura_crest_threshold.rs`.
+
+use javari_core::analysis::cents;
+use javari_core::analysis::listening::{sustained_pitch_hz, SUSTAIN_WINDOW_S};
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::fd::{FdString, FdStringConfig};
+use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
+use std::sync::Mutex;
+
+const OUTPUT_RATE_HZ: f64 = 44_100.0;
+const KEYS: [u8; 6] = [49, 50, 51, 52, 53, 54];
+const VELOCITIES: [u8; 4] = [1, 40, 80, 127];
+
+/// A discretisation of the seed's string at a given tension.
+#[derive(Clone, Copy)]
+enum Scheme {
+    /// FD with `intervals` and `oversampling` × 44.1 kHz.
+    Fd(usize, usize),
+    /// Modal (f64) with bridge points `spacing` apart (the thread's half of it), `residual`
+    /// residual modes and the static compliance frozen in (`flexibility`).
+    Modal(f64, usize, bool),
+}
+
+impl Scheme {
+    fn name(self) -> String {
+        match self {
+            Scheme::Fd(intervals, oversampling) => format!("FD N = {intervals}, {oversampling}x"),
+            Scheme::Modal(spacing, residual, flexibility) => format!(
+                "modal, {:.2} mm, {}",
+                spacing * 1e3,
+                match (residual, flexibility) {
+                    (0, false) => "kept modes only".to_owned(),
+                    (_, true) => "static compliance".to_owned(),
+                    (residual, false) => format!("{residual} residual modes"),
+                }
+            ),
+        }
+    }
+
+    fn fd_config(intervals: usize, oversampling: usize, tension_n: f64) -> FdStringConfig {
+        let mut config = FdStringConfig {
+            intervals,
+            time_step_s: 1.0 / (OUTPUT_RATE_HZ * oversampling as f64),
+            ..FdStringConfig::REFERENCE
+        };
+        config.string.tension_n = tension_n;
+        config
+    }
+
+    fn modal_config(
+        spacing: f64,
+        residual: usize,
+        flexibility: bool,
+        tension_n: f64,
+    ) -> ModalStringConfig {
+        let mut config = ModalStringConfig {
+            bridge_point_spacing_m: spacing,
+            thread_point_spacing_m: 0.5 * spacing,
+            residual_modes: residual,
+            static_flexibility: flexibility,
+            ..ModalStringConfig::REFERENCE
+        };
+        config.string.tension_n = tension_n;
+        config
+    }
+
+    /// The deepest bridge gap at rest, µm (positive: into the crest).
+    fn deepest_rest_gap_um(self, tension_n: f64) -> f64 {
+        let deepest = |gaps: &mut dyn Iterator<Item = f64>| gaps.fold(f64::MIN, f64::max) * 1e6;
+        match self {
+            Scheme::Fd(intervals, oversampling) => {
+                let string = FdString::new(Self::fd_config(intervals, oversampling, tension_n));
+                let grid = string.bridge_grid();
+                deepest(
+                    &mut (0..grid.len()).map(|i| {
+                        grid.heights_m()[i] - grid.interpolate(string.displacement_m(), i)
+                    }),
+                )
+            }
+            Scheme::Modal(spacing, residual, flexibility) => {
+                let string: ModalString<f64> = ModalString::new(Self::modal_config(
+                    spacing,
+                    residual,
+                    flexibility,
+                    tension_n,
+                ));
+                let bridge = string.bridge_point_count();
+                deepest(&mut string.gaps_m()[..bridge].iter().copied())
+            }
+        }
+    }
+
+    /// The nut force at 44.1 kHz to the end of the sustain window, plucked at `velocity`.
+    fn pluck_nut_force(self, tension_n: f64, velocity: f64) -> Vec<f64> {
+        let pluck = Pluck {
+            amplitude_m: Pluck::default().amplitude_m * velocity,
+            ..Pluck::default()
+        };
+        let samples = (SUSTAIN_WINDOW_S.1 * OUTPUT_RATE_HZ).round() as usize;
+        match self {
+            Scheme::Fd(intervals, oversampling) => {
+                let mut string = FdString::new(Self::fd_config(intervals, oversampling, tension_n));
+                string.pluck(&pluck);
+                // Block means of the oversampled force: low-pass enough for a fundamental.
+                (0..samples)
+                    .map(|_| {
+                        (0..oversampling)
+                            .map(|_| {
+                                string.step();
+                                string.nut_force_n()
+                            })
+                            .sum::<f64>()
+                            / oversampling as f64
+                    })
+                    .collect()
+            }
+            Scheme::Modal(spacing, residual, flexibility) => {
+                let mut string: ModalString<f64> = ModalString::new(Self::modal_config(
+                    spacing,
+                    residual,
+                    flexibility,
+                    tension_n,
+                ));
+                string.pluck(&pluck);
+                (0..samples)
+                    .map(|_| {
+                        string.step();
+                        string.nut_force_n()
+                    })
+                    .collect()
+            }
+        }
+    }
+}
+
+fn key_hz(key: u8) -> f64 {
+    440.0 * ((f64::from(key) - 69.0) / 12.0).exp2()
+}
+
+fn main() {
+    let seed_tension = FdStringConfig::REFERENCE.string.tension_n;
+    let seed_hz = FdString::new(FdStringConfig::REFERENCE).linearised_fundamental_hz();
+    let tension_of = |key: u8| seed_tension * (key_hz(key) / seed_hz).powi(2);
+    println!(
+        "The seed's string at the tension of each key (seed: {seed_tension:.2} N, {seed_hz:.2} Hz \
+         on the reference grid)"
+    );
+
+    let static_schemes = [
+        Scheme::Fd(200, 4),
+        Scheme::Fd(400, 8),
+        Scheme::Fd(800, 16),
+        Scheme::Modal(1e-3, 0, false),
+        Scheme::Modal(1e-3, 2, false),
+        Scheme::Modal(1e-3, 0, true),
+        Scheme::Modal(0.25e-3, 0, true),
+    ];
+    println!("\n1. At rest: the deepest bridge gap, µm (positive: into the crest)");
+    print!("| scheme |");
+    for key in KEYS {
+        print!(" key {key} |");
+    }
+    println!();
+    for scheme in static_schemes {
+        print!("| {} |", scheme.name());
+        for key in KEYS {
+            print!(" {:+.2} |", scheme.deepest_rest_gap_um(tension_of(key)));
+        }
+        println!();
+    }
+
+    let dynamic_schemes = [
+        Scheme::Fd(200, 4),
+        Scheme::Fd(400, 8),
+        Scheme::Fd(800, 16),
+        Scheme::Modal(1e-3, 2, false),
+        Scheme::Modal(0.25e-3, 2, false),
+    ];
+    println!(
+        "\n2. Plucked: the sustained pitch at velocities {:?}, cents from the pitch at velocity 1",
+        &VELOCITIES[1..]
+    );
+    // Every (scheme, key) on the machine's cores; each renders its four velocities.
+    let jobs: Vec<(usize, usize)> = (0..dynamic_schemes.len())
+        .flat_map(|s| (0..KEYS.len()).map(move |k| (s, k)))
+        .collect();
+    let next = Mutex::new(0usize);
+    let results = Mutex::new(vec![vec![Vec::new(); KEYS.len()]; dynamic_schemes.len()]);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let job = {
+                    let mut next = next.lock().unwrap();
+                    let job = jobs.get(*next).copied();
+                    *next += 1;
+                    job
+                };
+                let Some((s, k)) = job else { break };
+                let (scheme, key) = (dynamic_schemes[s], KEYS[k]);
+                let pitches: Vec<f64> = VELOCITIES
+                    .iter()
+                    .map(|&velocity| {
+                        let force =
+                            scheme.pluck_nut_force(tension_of(key), f64::from(velocity) / 127.0);
+                        sustained_pitch_hz(&force, OUTPUT_RATE_HZ, key_hz(key))
+                    })
+                    .collect();
+                let soft = pitches[0];
+                results.lock().unwrap()[s][k] = pitches[1..]
+                    .iter()
+                    .map(|&pitch| cents(pitch, soft))
+                    .collect();
+            });
+        }
+    });
+    let results = results.into_inner().unwrap();
+    print!("| scheme |");
+    for key in KEYS {
+        print!(" key {key} |");
+    }
+    println!();
+    for (scheme, row) in dynamic_schemes.iter().zip(&results) {
+        print!("| {} |", scheme.name());
+        for cell in row {
+            let listed: Vec<String> = cell.iter().map(|c| format!("{c:+.1}")).collect();
+            print!(" {} |", listed.join(" "));
+        }
+        println!();
+    }
+}
