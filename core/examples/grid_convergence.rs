@@ -1,111 +1,169 @@
-//! How far the reference tier's own partials move when its grid is refined, against the distance
-//! between the modal and reference tiers: `cargo run --release --example grid_convergence`.
+//! How far the reference tier's own output moves when its grid is refined, against the distance
+//! between the modal and reference tiers: `cargo run --release --example grid_convergence`
+//! (about a minute on two cores).
 //!
-//! Renders the seed's string (its physical parameters as they are, no tuning per tier) plucked as
-//! in the bench, 2 s, on the FD scheme at the seed's grid (N = 200, 4× oversampling) and refined
-//! (N = 400 at 8× and 16×), and on the modal scheme at the live tier's point spacing and four times
-//! finer (and at the live spacing without the truncated modes' static flexibility); prints the first ten partials (0.5–2 s, the bench's measure) in cents against the seed
-//! grid. Then the rest states behind the difference between the schemes: each one's linearised
-//! fundamental and the end of its rest contact (thread only, or thread and bridge crest). About a
-//! minute on one core.
+//! Renders the seed's string (its physical parameters as they are, no tuning per scheme) plucked
+//! as in the bench, 3 s of its nut force (the seed's signal) at 44.1 kHz, on the FD scheme at the
+//! seed's grid (N = 200, 4× oversampling, the reference tier) and refined (N = 400 at 8× and 16×,
+//! N = 800 at 16×), each brought to 44.1 kHz by the tiers' Kaiser decimator, and on the modal
+//! scheme at the live tier's point spacing (kept modes only, as the tier runs) and, at 1 mm and
+//! 0.25 mm points, with the static flexibility and with two residual modes. Each render is measured as the bench
+//! measures its one-string scene (`javari_core::analysis`): the largest cents error of the first
+//! ten partials (0.5 s on), the third-octave spectral distance and the centroid course's error,
+//! against the seed's grid (what the bench reports), against N = 400 at 16× and against N = 800 at
+//! 16×. Then the
+//! rest states behind the difference between the schemes: each one's linearised fundamental and
+//! the end of its rest contact (thread only, or thread and bridge crest).
 
-use javari_core::analysis::{cents, peak_frequency_hz};
+use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz};
+use javari_core::analysis::{
+    cents, first_partials_hz, peak_frequency_hz, third_octave_distance_db,
+};
 use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::fd::decimator::Decimator;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
+use std::sync::Mutex;
 
-const SECONDS: f64 = 2.0;
+const SECONDS: f64 = 3.0;
 const OUTPUT_RATE_HZ: f64 = 44_100.0;
 
-/// Block means of `factor` samples: enough of a low-pass for partials below 2 kHz.
-fn decimate(signal: &[f64], factor: usize) -> Vec<f64> {
-    signal
-        .chunks_exact(factor)
-        .map(|block| block.iter().sum::<f64>() / factor as f64)
-        .collect()
+#[derive(Clone, Copy)]
+enum Scheme {
+    /// FD with `intervals` at `oversampling` × 44.1 kHz.
+    Fd(usize, usize),
+    /// Modal (f64) with bridge points `spacing` apart (the thread's half of it), `residual`
+    /// residual modes and the static compliance frozen in (`flexibility`).
+    Modal(f64, usize, bool),
 }
 
-/// The first ten partials from 0.5 s on, as the bench measures them.
-fn partials(output: &[f64], fundamental_hz: f64) -> Vec<f64> {
-    let start = (0.5 * OUTPUT_RATE_HZ) as usize;
-    (1..=10)
-        .map(|n| {
-            let expected = n as f64 * fundamental_hz;
-            peak_frequency_hz(
-                &output[start..],
-                OUTPUT_RATE_HZ,
-                expected * 0.97,
-                expected * 1.03,
-            )
-        })
-        .collect()
+impl Scheme {
+    fn name(self) -> String {
+        match self {
+            Scheme::Fd(200, 4) => "FD N = 200, 4x (the reference)".to_owned(),
+            Scheme::Fd(intervals, oversampling) => format!("FD N = {intervals}, {oversampling}x"),
+            Scheme::Modal(spacing, 0, false) => {
+                format!("modal, {:.2} mm, kept modes only", spacing * 1e3)
+            }
+            Scheme::Modal(spacing, 0, true) => {
+                format!("modal, {:.2} mm, static flexibility", spacing * 1e3)
+            }
+            Scheme::Modal(spacing, residual, _) => {
+                format!("modal, {:.2} mm, {residual} residual modes", spacing * 1e3)
+            }
+        }
+    }
+
+    fn render(self) -> Vec<f64> {
+        let samples = (SECONDS * OUTPUT_RATE_HZ) as usize;
+        match self {
+            Scheme::Fd(intervals, oversampling) => {
+                let mut string = FdString::new(FdStringConfig {
+                    intervals,
+                    time_step_s: 1.0 / (OUTPUT_RATE_HZ * oversampling as f64),
+                    ..FdStringConfig::REFERENCE
+                });
+                string.pluck(&Pluck::default());
+                let mut decimator = Decimator::new(oversampling);
+                let mut output = Vec::with_capacity(samples);
+                while output.len() < samples {
+                    string.step();
+                    if let Some(sample) = decimator.push(string.nut_force_n()) {
+                        output.push(sample);
+                    }
+                }
+                output
+            }
+            Scheme::Modal(spacing, residual_modes, static_flexibility) => {
+                let mut string: ModalString<f64> = ModalString::new(ModalStringConfig {
+                    bridge_point_spacing_m: spacing,
+                    thread_point_spacing_m: 0.5 * spacing,
+                    residual_modes,
+                    static_flexibility,
+                    ..ModalStringConfig::REFERENCE
+                });
+                string.pluck(&Pluck::default());
+                (0..samples)
+                    .map(|_| {
+                        string.step();
+                        string.nut_force_n()
+                    })
+                    .collect()
+            }
+        }
+    }
 }
 
-fn finite_difference(intervals: usize, oversampling: usize) -> Vec<f64> {
-    let config = FdStringConfig {
-        intervals,
-        time_step_s: 1.0 / (OUTPUT_RATE_HZ * oversampling as f64),
-        ..FdStringConfig::REFERENCE
-    };
-    let mut string = FdString::new(config);
-    string.pluck(&Pluck::default());
-    let steps = (SECONDS * OUTPUT_RATE_HZ) as usize * oversampling;
-    let nut: Vec<f64> = (0..steps)
-        .map(|_| {
-            string.step();
-            string.nut_force_n()
-        })
-        .collect();
-    decimate(&nut, oversampling)
-}
-
-fn modal(bridge_spacing_m: f64, static_flexibility: bool) -> Vec<f64> {
-    let config = ModalStringConfig {
-        bridge_point_spacing_m: bridge_spacing_m,
-        thread_point_spacing_m: 0.5 * bridge_spacing_m,
-        static_flexibility,
-        ..ModalStringConfig::REFERENCE
-    };
-    let mut string: ModalString<f64> = ModalString::new(config);
-    string.pluck(&Pluck::default());
-    (0..(SECONDS * OUTPUT_RATE_HZ) as usize)
-        .map(|_| {
-            string.step();
-            string.nut_force_n()
-        })
-        .collect()
+/// The bench's three one-string measures of `output` against `reference` (fundamental
+/// `fundamental_hz` for both: the strings are the same, untuned).
+fn measures(output: &[f64], reference: &[f64], fundamental_hz: f64) -> (f64, f64, f64) {
+    let partials = |signal: &[f64]| first_partials_hz(signal, OUTPUT_RATE_HZ, fundamental_hz, 10);
+    let worst_cents = partials(output)
+        .iter()
+        .zip(&partials(reference))
+        .map(|(a, b)| cents(*a, *b).abs())
+        .fold(0.0, f64::max);
+    let distance = third_octave_distance_db(output, reference, OUTPUT_RATE_HZ);
+    let course = |signal: &[f64]| centroid_course_hz(signal, OUTPUT_RATE_HZ, fundamental_hz);
+    let formant = centroid_course_error(&course(output), &course(reference));
+    (worst_cents, distance, 100.0 * formant)
 }
 
 fn main() {
-    let renders = [
-        ("FD N = 200, 4x (the reference)", finite_difference(200, 4)),
-        ("FD N = 400, 8x", finite_difference(400, 8)),
-        ("FD N = 400, 16x", finite_difference(400, 16)),
-        ("modal, live points, static flex.", modal(1e-3, true)),
-        ("modal, 0.25 mm, static flex.", modal(0.25e-3, true)),
-        ("modal, live (kept modes only)", modal(1e-3, false)),
+    let schemes = [
+        Scheme::Fd(200, 4),
+        Scheme::Fd(400, 8),
+        Scheme::Fd(400, 16),
+        Scheme::Fd(800, 16),
+        Scheme::Modal(1e-3, 0, false),
+        Scheme::Modal(1e-3, 0, true),
+        Scheme::Modal(0.25e-3, 0, true),
+        Scheme::Modal(1e-3, 2, false),
+        Scheme::Modal(0.25e-3, 2, false),
     ];
+    // The longest render (N = 800) first, so that the two cores finish together.
+    let order = [3, 0, 1, 2, 4, 5, 6, 7, 8];
+    let next = Mutex::new(0usize);
+    let renders = Mutex::new(vec![Vec::new(); schemes.len()]);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let index = {
+                    let mut next = next.lock().unwrap();
+                    let index = order.get(*next).copied();
+                    *next += 1;
+                    index
+                };
+                let Some(index) = index else { break };
+                let output = schemes[index].render();
+                renders.lock().unwrap()[index] = output;
+            });
+        }
+    });
+    let renders = renders.into_inner().unwrap();
     let start = (0.5 * OUTPUT_RATE_HZ) as usize;
-    let fundamental = peak_frequency_hz(&renders[0].1[start..], OUTPUT_RATE_HZ, 120.0, 260.0);
-    let reference = partials(&renders[0].1, fundamental);
-    println!("f0 = {fundamental:.3} Hz; partials 1-10 in cents against the seed's grid:");
-    for (name, output) in &renders {
-        let offsets: Vec<f64> = partials(output, fundamental)
-            .iter()
-            .zip(&reference)
-            .map(|(partial, reference)| cents(*partial, *reference))
-            .collect();
-        let worst = offsets.iter().fold(0.0f64, |m, c| m.max(c.abs()));
-        let spread = offsets.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
-            - offsets.iter().cloned().fold(f64::INFINITY, f64::min);
-        let listed: Vec<String> = offsets.iter().map(|c| format!("{c:+.2}")).collect();
+    let fundamental = peak_frequency_hz(&renders[0][start..], OUTPUT_RATE_HZ, 120.0, 260.0);
+    println!(
+        "f0 = {fundamental:.3} Hz; the bench's measures (worst of 10 partials, cents / spectral \
+         distance, dB / formant error, %)"
+    );
+    println!(
+        "| scheme | against N = 200 (the reference) | against N = 400, 16x | against N = 800, 16x |"
+    );
+    println!("|---|---|---|---|");
+    for (scheme, output) in schemes.iter().zip(&renders) {
+        let (c, d, f) = measures(output, &renders[0], fundamental);
+        let (c4, d4, f4) = measures(output, &renders[2], fundamental);
+        let (c8, d8, f8) = measures(output, &renders[3], fundamental);
         println!(
-            "{name:32} worst {worst:6.2}  spread {spread:5.2}  {}",
-            listed.join(" ")
+            "| {} | {c:.2} / {d:.1} / {f:.1} | {c4:.2} / {d4:.1} / {f4:.1} | {c8:.2} / {d8:.1} / {f8:.1} |",
+            scheme.name()
         );
     }
-    println!("rest states: linearised fundamental, end of the rest contact");
-    for intervals in [200, 400] {
+
+    println!("\nrest states: linearised fundamental, end of the rest contact");
+    for intervals in [200, 400, 800] {
         let mut string = FdString::new(FdStringConfig {
             intervals,
             ..FdStringConfig::REFERENCE

@@ -16,7 +16,7 @@ use crate::args::number_in;
 use crate::playing_range::{self, TierOverGrid};
 use clap::Parser;
 use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz};
-use javari_core::analysis::{band_power, cents, peak_frequency_hz, power_spectrum};
+use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
 use javari_core::newton::NewtonStats;
@@ -293,70 +293,20 @@ fn measure_best(
     best.expect("at least one run")
 }
 
-/// Frequencies of the first ten partials, from the second half-second onwards.
-fn partials(output: &[f64], fundamental_hz: f64) -> Vec<f64> {
-    let start = (0.5 * SAMPLE_RATE) as usize;
-    let signal = &output[start.min(output.len())..];
-    (1..=10)
-        .map(|n| {
-            let expected = n as f64 * fundamental_hz;
-            peak_frequency_hz(signal, SAMPLE_RATE, expected * 0.97, expected * 1.03)
-        })
-        .collect()
-}
-
-const FRAME: usize = 4096;
-
-/// Third-octave band levels (dB) of each frame, 40 Hz to 16 kHz.
-fn band_levels(output: &[f64]) -> Vec<Vec<f64>> {
-    let bin = SAMPLE_RATE / FRAME as f64;
-    (0..output.len() / FRAME)
-        .map(|frame| {
-            let spectrum = power_spectrum(output, frame * FRAME, FRAME, FRAME);
-            let mut levels = Vec::new();
-            let mut low = 40.0;
-            while low < 16_000.0 {
-                let high = low * 2f64.powf(1.0 / 3.0);
-                levels.push(10.0 * (band_power(&spectrum, bin, low, high) + 1e-30).log10());
-                low = high;
-            }
-            levels
-        })
-        .collect()
-}
-
-/// RMS difference of the third-octave band levels (dB) over bands within 60 dB of the
-/// reference frame's loudest band, averaged over frames: a timbre distance that small pitch
-/// differences do not dominate.
-fn spectral_distance_db(output: &[f64], reference: &[f64]) -> f64 {
-    let (a, b) = (band_levels(output), band_levels(reference));
-    let frames = a.len().min(b.len());
-    let mut total = 0.0;
-    for frame in 0..frames {
-        let floor = b[frame].iter().cloned().fold(f64::MIN, f64::max) - 60.0;
-        let (mut sum, mut count) = (0.0, 0usize);
-        for (x, r) in a[frame].iter().zip(&b[frame]) {
-            if *r > floor {
-                // A band the tier leaves empty counts as the 60 dB it lies below the floor.
-                sum += (x.max(floor) - r).powi(2);
-                count += 1;
-            }
-        }
-        total += (sum / count.max(1) as f64).sqrt();
-    }
-    total / frames.max(1) as f64
-}
-
 fn compare_with_reference(result: &mut BenchResult, reference: &BenchResult) {
-    let mine = partials(&result.output, result.fundamental_hz);
-    let theirs = partials(&reference.output, reference.fundamental_hz);
+    let mine = first_partials_hz(&result.output, SAMPLE_RATE, result.fundamental_hz, 10);
+    let theirs = first_partials_hz(&reference.output, SAMPLE_RATE, reference.fundamental_hz, 10);
     result.cents_error_max = Some(
         mine.iter()
             .zip(&theirs)
             .map(|(a, b)| cents(*a, *b).abs())
             .fold(0.0, f64::max),
     );
-    result.spectral_distance_db = Some(spectral_distance_db(&result.output, &reference.output));
+    result.spectral_distance_db = Some(third_octave_distance_db(
+        &result.output,
+        &reference.output,
+        SAMPLE_RATE,
+    ));
     // The formant measure of the playing-range grid (listening.rs), at each render's own f₀.
     result.formant_error = Some(centroid_course_error(
         &centroid_course_hz(&result.output, SAMPLE_RATE, result.fundamental_hz),

@@ -186,6 +186,78 @@ pub fn band_power(spectrum: &[f64], bin_hz: f64, low_hz: f64, high_hz: f64) -> f
         .sum()
 }
 
+/// The bench's one-string measures (`cargo xtask bench`): the first `count` partials and a
+/// timbre distance between two renders.
+///
+/// The frequencies of the first `count` partials of `signal` from 0.5 s on, each the peak within
+/// ±3 % of n·`fundamental_hz`, Hz.
+pub fn first_partials_hz(
+    signal: &[f64],
+    sample_rate_hz: f64,
+    fundamental_hz: f64,
+    count: usize,
+) -> Vec<f64> {
+    let start = (0.5 * sample_rate_hz) as usize;
+    let signal = &signal[start.min(signal.len())..];
+    (1..=count)
+        .map(|n| {
+            let expected = n as f64 * fundamental_hz;
+            peak_frequency_hz(signal, sample_rate_hz, expected * 0.97, expected * 1.03)
+        })
+        .collect()
+}
+
+/// Frame length of [`third_octave_levels_db`], samples.
+pub const THIRD_OCTAVE_FRAME: usize = 4096;
+
+/// Third-octave band levels (dB) of each [`THIRD_OCTAVE_FRAME`]-sample frame, 40 Hz to 16 kHz.
+pub fn third_octave_levels_db(signal: &[f64], sample_rate_hz: f64) -> Vec<Vec<f64>> {
+    let bin = sample_rate_hz / THIRD_OCTAVE_FRAME as f64;
+    (0..signal.len() / THIRD_OCTAVE_FRAME)
+        .map(|frame| {
+            let spectrum = power_spectrum(
+                signal,
+                frame * THIRD_OCTAVE_FRAME,
+                THIRD_OCTAVE_FRAME,
+                THIRD_OCTAVE_FRAME,
+            );
+            let mut levels = Vec::new();
+            let mut low = 40.0;
+            while low < 16_000.0 {
+                let high = low * 2f64.powf(1.0 / 3.0);
+                levels.push(10.0 * (band_power(&spectrum, bin, low, high) + 1e-30).log10());
+                low = high;
+            }
+            levels
+        })
+        .collect()
+}
+
+/// The bench's spectral distance of `signal` from `reference`: the RMS difference of their
+/// third-octave band levels (dB) over the bands within 60 dB of the reference frame's loudest
+/// band, averaged over frames; a band the signal leaves empty counts as the 60 dB it lies below
+/// that floor. A timbre distance that small pitch differences do not dominate.
+pub fn third_octave_distance_db(signal: &[f64], reference: &[f64], sample_rate_hz: f64) -> f64 {
+    let (a, b) = (
+        third_octave_levels_db(signal, sample_rate_hz),
+        third_octave_levels_db(reference, sample_rate_hz),
+    );
+    let frames = a.len().min(b.len());
+    let mut total = 0.0;
+    for frame in 0..frames {
+        let floor = b[frame].iter().cloned().fold(f64::MIN, f64::max) - 60.0;
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (x, r) in a[frame].iter().zip(&b[frame]) {
+            if *r > floor {
+                sum += (x.max(floor) - r).powi(2);
+                count += 1;
+            }
+        }
+        total += (sum / count.max(1) as f64).sqrt();
+    }
+    total / frames.max(1) as f64
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
