@@ -21,7 +21,10 @@ use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice,
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
 use javari_core::newton::NewtonStats;
 use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::fd::decimator::Decimator;
+use javari_core::tanpura::fd::FdString;
 use javari_core::tanpura::quality::Quality;
+use javari_core::tanpura::tier_string::weighted_pickup_n;
 use javari_core::tanpura::{FirstString, Tanpura, TanpuraVoice, VoiceSettings};
 use std::error::Error;
 use std::fmt::Write as _;
@@ -293,25 +296,137 @@ fn measure_best(
     best.expect("at least one run")
 }
 
-fn compare_with_reference(result: &mut BenchResult, reference: &BenchResult) {
-    let mine = first_partials_hz(&result.output, SAMPLE_RATE, result.fundamental_hz, 10);
-    let theirs = first_partials_hz(&reference.output, SAMPLE_RATE, reference.fundamental_hz, 10);
-    result.cents_error_max = Some(
-        mine.iter()
-            .zip(&theirs)
-            .map(|(a, b)| cents(*a, *b).abs())
-            .fold(0.0, f64::max),
+/// The one-string measures of `output` (fundamental `fundamental_hz`) against `yardstick`
+/// (`yardstick_hz`): the largest cents error of the first ten partials, the third-octave
+/// spectral distance (dB) and the formant measure of the playing-range grid (listening.rs), each
+/// render at its own f₀.
+fn errors_against(
+    output: &[f64],
+    fundamental_hz: f64,
+    yardstick: &[f64],
+    yardstick_hz: f64,
+) -> (f64, f64, f64) {
+    let mine = first_partials_hz(output, SAMPLE_RATE, fundamental_hz, 10);
+    let theirs = first_partials_hz(yardstick, SAMPLE_RATE, yardstick_hz, 10);
+    let cents_error = mine
+        .iter()
+        .zip(&theirs)
+        .map(|(a, b)| cents(*a, *b).abs())
+        .fold(0.0, f64::max);
+    let distance = third_octave_distance_db(output, yardstick, SAMPLE_RATE);
+    let formant = centroid_course_error(
+        &centroid_course_hz(output, SAMPLE_RATE, fundamental_hz),
+        &centroid_course_hz(yardstick, SAMPLE_RATE, yardstick_hz),
     );
-    result.spectral_distance_db = Some(third_octave_distance_db(
+    (cents_error, distance, formant)
+}
+
+fn compare_with_reference(result: &mut BenchResult, reference: &BenchResult) {
+    let (cents_error, distance, formant) = errors_against(
         &result.output,
+        result.fundamental_hz,
         &reference.output,
-        SAMPLE_RATE,
-    ));
-    // The formant measure of the playing-range grid (listening.rs), at each render's own f₀.
-    result.formant_error = Some(centroid_course_error(
-        &centroid_course_hz(&result.output, SAMPLE_RATE, result.fundamental_hz),
-        &centroid_course_hz(&reference.output, SAMPLE_RATE, reference.fundamental_hz),
-    ));
+        reference.fundamental_hz,
+    );
+    result.cents_error_max = Some(cents_error);
+    result.spectral_distance_db = Some(distance);
+    result.formant_error = Some(formant);
+}
+
+/// How far the reference tier's own one-string render lies from the seed's scheme on a finer
+/// grid, on the same measures: the yardstick the tiers' errors against the reference are read
+/// with (`docs/modal-tanpura.md`, section 9).
+#[derive(Debug, Clone, Copy)]
+pub struct ReferenceRefinement {
+    pub intervals: usize,
+    pub oversample: usize,
+    pub cents_error_max: f64,
+    pub spectral_distance_db: f64,
+    pub formant_error: f64,
+}
+
+/// The refinement of [`refined_reference`]: four times the reference's intervals and its
+/// oversampling (16× the work per second of sound, by count).
+const REFINEMENT: usize = 4;
+
+/// The one-string scene on the seed's scheme with [`REFINEMENT`] times the reference tier's
+/// intervals and oversampling (its barrier points as they are), configured, tuned (the voice's
+/// passes on its linearised fundamental), plucked and picked up as the reference tier's voice
+/// does, through the tiers' Kaiser decimator; and the reference tier's `reference` render
+/// measured against it.
+fn refined_reference(reference: &BenchResult, seconds: f64) -> Option<ReferenceRefinement> {
+    let settings = settings_at(Quality::Reference);
+    let tier = Quality::Reference.fd_tier()?;
+    let (intervals, oversample) = (tier.intervals * REFINEMENT, tier.oversample * REFINEMENT);
+    let mut config = settings.fd_config_at(Quality::Reference, SAMPLE_RATE)?;
+    config.intervals = intervals;
+    config.time_step_s = 1.0 / (SAMPLE_RATE * oversample as f64);
+    let mut string = FdString::new(config);
+    for _ in 0..2 {
+        let linearised = string.linearised_fundamental_hz();
+        if !(linearised.is_finite() && linearised > 0.0) {
+            return None;
+        }
+        config.string.tension_n *= (settings.fundamental_hz / linearised).powi(2);
+        string.set_config(config);
+    }
+    string.pluck(&Pluck::default());
+    let mut decimator = Decimator::new(oversample);
+    let samples = (seconds * SAMPLE_RATE) as usize;
+    let mut output = Vec::with_capacity(samples);
+    while output.len() < samples {
+        string.step();
+        let pickup = weighted_pickup_n(
+            settings.nut_pickup_weight,
+            string.nut_force_n() - string.rest_nut_force_n(),
+            string.bridge_force_n() - string.rest_bridge_force_n(),
+        );
+        if let Some(sample) = decimator.push(pickup) {
+            // The voice's output is f32.
+            output.push(f64::from(sample as f32));
+        }
+    }
+    let (cents_error_max, spectral_distance_db, formant_error) = errors_against(
+        &reference.output,
+        reference.fundamental_hz,
+        &output,
+        settings.fundamental_hz,
+    );
+    Some(ReferenceRefinement {
+        intervals,
+        oversample,
+        cents_error_max,
+        spectral_distance_db,
+        formant_error,
+    })
+}
+
+/// [`refined_reference`] for the one-string scene of `results`, if it was run.
+pub fn run_reference_refinement(
+    results: &[BenchResult],
+    seconds: f64,
+) -> Option<ReferenceRefinement> {
+    let reference = results
+        .iter()
+        .find(|r| r.voice == "tanpura" && r.tier == "reference" && r.scene == "one-string")?;
+    eprintln!("bench: one-string, reference against a grid {REFINEMENT} times finer ...");
+    refined_reference(reference, seconds)
+}
+
+/// The markdown paragraph of [`ReferenceRefinement`].
+pub fn refinement_markdown(refinement: &ReferenceRefinement) -> String {
+    format!(
+        "
+The reference tier's own error on the one-string measures: its render against the \
+         seed's scheme on a grid {REFINEMENT} times finer (N = {}, {}× oversampling; tuned, \
+         plucked and picked up as the scene's voice) lies {:.2} cents (10 partials), {:.1} dB \
+         (spectral distance) and {:.1} % (formant error) from it.\n",
+        refinement.intervals,
+        refinement.oversample,
+        refinement.cents_error_max,
+        refinement.spectral_distance_db,
+        100.0 * refinement.formant_error,
+    )
 }
 
 fn settings_at(quality: Quality) -> VoiceSettings {
@@ -682,6 +797,7 @@ pub fn to_json(
     results: &[BenchResult],
     economy: &[EconomyRow],
     grid: &[TierOverGrid],
+    refinement: Option<&ReferenceRefinement>,
 ) -> String {
     let rows: Vec<String> = results
         .iter()
@@ -717,13 +833,25 @@ pub fn to_json(
             )
         })
         .collect();
+    let refinement = refinement.map_or("null".to_string(), |r| {
+        format!(
+            "{{\"intervals\": {}, \"oversample\": {}, \"cents_error_max\": {}, \
+             \"spectral_distance_db\": {}, \"formant_error\": {}}}",
+            r.intervals,
+            r.oversample,
+            json_number(Some(r.cents_error_max)),
+            json_number(Some(r.spectral_distance_db)),
+            json_number(Some(r.formant_error)),
+        )
+    });
     format!(
         "{{\"machine\": \"{}\", \"results\": [\n  {}\n], \"economy\": [\n  {}\n], \
-         \"playing_range\": [\n  {}\n]}}\n",
+         \"playing_range\": [\n  {}\n], \"reference_refinement\": {}}}\n",
         machine.replace('"', "'"),
         rows.join(",\n  "),
         economy_rows.join(",\n  "),
-        playing_range::to_json_rows(grid).join(",\n  ")
+        playing_range::to_json_rows(grid).join(",\n  "),
+        refinement
     )
 }
 
@@ -797,6 +925,7 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     } else {
         (run_all(seconds, runs), run_economy(seconds, runs))
     };
+    let refinement = run_reference_refinement(&results, seconds);
     let grid = if no_grid {
         Vec::new()
     } else {
@@ -815,6 +944,9 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
         table += &playing_range::to_markdown(&grid);
     }
     table += &targets_markdown(&results, &grid);
+    if let Some(refinement) = &refinement {
+        table += &refinement_markdown(refinement);
+    }
     if !economy.is_empty() {
         table += &economy_markdown(&economy);
     }
@@ -822,8 +954,11 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     std::fs::write(&markdown, &table)
         .map_err(|error| format!("cannot write `{}`: {error}", markdown.display()))?;
     if let Some(path) = json {
-        std::fs::write(&path, to_json(&machine, &results, &economy, &grid))
-            .map_err(|error| format!("cannot write `{}`: {error}", path.display()))?;
+        std::fs::write(
+            &path,
+            to_json(&machine, &results, &economy, &grid, refinement.as_ref()),
+        )
+        .map_err(|error| format!("cannot write `{}`: {error}", path.display()))?;
     }
     Ok(())
 }
