@@ -1,6 +1,6 @@
 //! Where the string starts to rest on the bridge's crest, and how a pluck there sounds, on the
 //! reference tier's grid and on finer ones: `cargo run --release -p javari-core --example
-//! crest_threshold` (about three minutes on two cores).
+//! crest_threshold` (about a minute on two cores).
 //!
 //! The playing-range grid's worst plucks (README, issue 15) all lie at keys 48–54, where the
 //! reference tier's string at rest just touches the bridge's crest, 7 mm past the thread. Whether
@@ -15,20 +15,26 @@
 //!    tier's 1 mm bridge points with its kept modes only, with two residual modes, and with the
 //!    whole string's static compliance (the closed-form Green's function, `static_flexibility`), at
 //!    1 mm and at 0.25 mm points.
-//! 2. Plucked as the bench plucks, at MIDI velocities 40, 80 and 127: the sustained pitch
-//!    (0.3–1.5 s, the grid's measure) in cents from the same string's pitch at velocity 1 (its
-//!    small-amplitude pitch), on the FD scheme at N = 200 (4× oversampled, the reference), 400 (8×)
-//!    and 800 (16×), and on the modal scheme (f64) with two residual modes at 1 mm and 0.25 mm
-//!    points. A string that a pluck lifts off the crest sounds about 10 cents flat of its
-//!    small-amplitude pitch.
+//! 2. Plucked as the bench plucks, at MIDI velocities 40, 80 and 127, for a grid note's length
+//!    (1.6 s; FD through the tiers' decimator): the sustained pitch (0.3–1.5 s, the grid's
+//!    measure) in cents from the same string's pitch at velocity 1 (its small-amplitude pitch),
+//!    on the FD scheme at N = 200 (4× oversampled, the reference), 400 (8×) and 800 (16×), and on
+//!    the modal scheme (f64) at 1 mm points with the kept modes only (the live tier) and with two
+//!    residual modes, and at 0.25 mm points with two residual modes. A string that a pluck lifts
+//!    off the crest sounds about 10 cents flat of its small-amplitude pitch.
+//! 3. The same renders against N = 800 on the playing-range grid's measures
+//!    (`listening::compare`), worst over velocities 1, 40, 80 and 127: sustained pitch, band
+//!    levels, centroid course.
 //!
 //! The FD grids refine the string and the time step; the barrier's points stay the seed's (every
 //! 0.18 mm on the bridge, 0.15 mm on the thread). The figures are quoted in `docs/modal-tanpura.md`, section 9; the static part is asserted by
 //! `core/tests/tanpura_crest_threshold.rs`.
 
 use javari_core::analysis::cents;
-use javari_core::analysis::listening::{sustained_pitch_hz, SUSTAIN_WINDOW_S};
+use javari_core::analysis::listening::{compare, sustained_pitch_hz};
+use javari_core::analysis::playing_range::NOTE_SECONDS;
 use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::fd::decimator::Decimator;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
 use std::sync::Mutex;
@@ -36,6 +42,8 @@ use std::sync::Mutex;
 const OUTPUT_RATE_HZ: f64 = 44_100.0;
 const KEYS: [u8; 6] = [49, 50, 51, 52, 53, 54];
 const VELOCITIES: [u8; 4] = [1, 40, 80, 127];
+/// The index of N = 800 at 16× among the plucked schemes: the yardstick of part 3.
+const FINE: usize = 2;
 
 /// A discretisation of the seed's string at a given tension.
 #[derive(Clone, Copy)]
@@ -116,29 +124,27 @@ impl Scheme {
         }
     }
 
-    /// The nut force at 44.1 kHz to the end of the sustain window, plucked at `velocity`.
+    /// The nut force at 44.1 kHz for a grid note's length ([`NOTE_SECONDS`]), plucked at
+    /// `velocity` (FD through the tiers' Kaiser decimator).
     fn pluck_nut_force(self, tension_n: f64, velocity: f64) -> Vec<f64> {
         let pluck = Pluck {
             amplitude_m: Pluck::default().amplitude_m * velocity,
             ..Pluck::default()
         };
-        let samples = (SUSTAIN_WINDOW_S.1 * OUTPUT_RATE_HZ).round() as usize;
+        let samples = (NOTE_SECONDS * OUTPUT_RATE_HZ).round() as usize;
         match self {
             Scheme::Fd(intervals, oversampling) => {
                 let mut string = FdString::new(Self::fd_config(intervals, oversampling, tension_n));
                 string.pluck(&pluck);
-                // Block means of the oversampled force: low-pass enough for a fundamental.
-                (0..samples)
-                    .map(|_| {
-                        (0..oversampling)
-                            .map(|_| {
-                                string.step();
-                                string.nut_force_n()
-                            })
-                            .sum::<f64>()
-                            / oversampling as f64
-                    })
-                    .collect()
+                let mut decimator = Decimator::new(oversampling);
+                let mut output = Vec::with_capacity(samples);
+                while output.len() < samples {
+                    string.step();
+                    if let Some(sample) = decimator.push(string.nut_force_n()) {
+                        output.push(sample);
+                    }
+                }
+                output
             }
             Scheme::Modal(spacing, residual, flexibility) => {
                 let mut string: ModalString<f64> = ModalString::new(Self::modal_config(
@@ -199,19 +205,18 @@ fn main() {
         Scheme::Fd(200, 4),
         Scheme::Fd(400, 8),
         Scheme::Fd(800, 16),
+        Scheme::Modal(1e-3, 0, false),
         Scheme::Modal(1e-3, 2, false),
         Scheme::Modal(0.25e-3, 2, false),
     ];
-    println!(
-        "\n2. Plucked: the sustained pitch at velocities {:?}, cents from the pitch at velocity 1",
-        &VELOCITIES[1..]
-    );
-    // Every (scheme, key) on the machine's cores; each renders its four velocities.
-    let jobs: Vec<(usize, usize)> = (0..dynamic_schemes.len())
+    // Every (scheme, key) on the machine's cores, the slowest first; each renders its four
+    // velocities.
+    let mut jobs: Vec<(usize, usize)> = (0..dynamic_schemes.len())
         .flat_map(|s| (0..KEYS.len()).map(move |k| (s, k)))
         .collect();
+    jobs.sort_by_key(|&(s, _)| usize::from(s != FINE));
     let next = Mutex::new(0usize);
-    let results = Mutex::new(vec![vec![Vec::new(); KEYS.len()]; dynamic_schemes.len()]);
+    let renders = Mutex::new(vec![vec![Vec::new(); KEYS.len()]; dynamic_schemes.len()]);
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     std::thread::scope(|scope| {
         for _ in 0..threads {
@@ -224,33 +229,61 @@ fn main() {
                 };
                 let Some((s, k)) = job else { break };
                 let (scheme, key) = (dynamic_schemes[s], KEYS[k]);
-                let pitches: Vec<f64> = VELOCITIES
+                let forces: Vec<Vec<f64>> = VELOCITIES
                     .iter()
                     .map(|&velocity| {
-                        let force =
-                            scheme.pluck_nut_force(tension_of(key), f64::from(velocity) / 127.0);
-                        sustained_pitch_hz(&force, OUTPUT_RATE_HZ, key_hz(key))
+                        scheme.pluck_nut_force(tension_of(key), f64::from(velocity) / 127.0)
                     })
                     .collect();
-                let soft = pitches[0];
-                results.lock().unwrap()[s][k] = pitches[1..]
-                    .iter()
-                    .map(|&pitch| cents(pitch, soft))
-                    .collect();
+                renders.lock().unwrap()[s][k] = forces;
             });
         }
     });
-    let results = results.into_inner().unwrap();
-    print!("| scheme |");
-    for key in KEYS {
-        print!(" key {key} |");
-    }
-    println!();
-    for (scheme, row) in dynamic_schemes.iter().zip(&results) {
+    let renders = renders.into_inner().unwrap();
+    let header = || {
+        print!("| scheme |");
+        for key in KEYS {
+            print!(" key {key} |");
+        }
+        println!();
+    };
+
+    println!(
+        "\n2. Plucked: the sustained pitch at velocities {:?}, cents from the pitch at velocity 1",
+        &VELOCITIES[1..]
+    );
+    header();
+    for (scheme, row) in dynamic_schemes.iter().zip(&renders) {
         print!("| {} |", scheme.name());
-        for cell in row {
-            let listed: Vec<String> = cell.iter().map(|c| format!("{c:+.1}")).collect();
+        for (&key, forces) in KEYS.iter().zip(row) {
+            let pitch = |force: &[f64]| sustained_pitch_hz(force, OUTPUT_RATE_HZ, key_hz(key));
+            let soft = pitch(&forces[0]);
+            let listed: Vec<String> = forces[1..]
+                .iter()
+                .map(|force| format!("{:+.1}", cents(pitch(force), soft)))
+                .collect();
             print!(" {} |", listed.join(" "));
+        }
+        println!();
+    }
+
+    println!(
+        "\n3. Against N = 800 at 16x, the playing-range grid's measures, worst over velocities \
+         {VELOCITIES:?}: sustained pitch (cents) / 1/6-octave band levels (dB RMS) / centroid \
+         course (%)"
+    );
+    header();
+    for (scheme, row) in dynamic_schemes.iter().zip(&renders) {
+        print!("| {} |", scheme.name());
+        for (k, forces) in row.iter().enumerate() {
+            let (mut pitch, mut bands, mut centroid) = (0.0f64, 0.0f64, 0.0f64);
+            for (force, fine) in forces.iter().zip(&renders[FINE][k]) {
+                let difference = compare(force, fine, OUTPUT_RATE_HZ, key_hz(KEYS[k]));
+                pitch = pitch.max(difference.sustained_cents.abs());
+                bands = bands.max(difference.band_level_db);
+                centroid = centroid.max(100.0 * difference.centroid_error);
+            }
+            print!(" {pitch:.1} / {bands:.1} / {centroid:.0} |");
         }
         println!();
     }
