@@ -333,28 +333,35 @@ fn compare_with_reference(result: &mut BenchResult, reference: &BenchResult) {
     result.formant_error = Some(formant);
 }
 
-/// How far the reference tier's own one-string render lies from the seed's scheme on a finer
-/// grid, on the same measures: the yardstick the tiers' errors against the reference are read
-/// with (`docs/modal-tanpura.md`, section 9).
+/// One tier's one-string render against the refined render: the bench's three measures.
 #[derive(Debug, Clone, Copy)]
-pub struct ReferenceRefinement {
-    pub intervals: usize,
-    pub oversample: usize,
+pub struct AgainstRefinement {
+    pub tier: &'static str,
     pub cents_error_max: f64,
     pub spectral_distance_db: f64,
     pub formant_error: f64,
 }
 
-/// The refinement of [`refined_reference`]: four times the reference's intervals and its
+/// Every tier's one-string render against the seed's scheme on a finer grid, on the same
+/// measures: the reference tier's row is its own discretisation error, the yardstick the tiers'
+/// errors against the reference are read with (`docs/modal-tanpura.md`, section 9).
+#[derive(Debug, Clone)]
+pub struct ReferenceRefinement {
+    pub intervals: usize,
+    pub oversample: usize,
+    /// The reference first, then the other tiers from the finest down.
+    pub tiers: Vec<AgainstRefinement>,
+}
+
+/// The refinement of [`refined_one_string`]: four times the reference's intervals and its
 /// oversampling (16× the work per second of sound, by count).
 const REFINEMENT: usize = 4;
 
 /// The one-string scene on the seed's scheme with [`REFINEMENT`] times the reference tier's
 /// intervals and oversampling (its barrier points as they are), configured, tuned (the voice's
 /// passes on its linearised fundamental), plucked and picked up as the reference tier's voice
-/// does, through the tiers' Kaiser decimator; and the reference tier's `reference` render
-/// measured against it.
-fn refined_reference(reference: &BenchResult, seconds: f64) -> Option<ReferenceRefinement> {
+/// does, through the tiers' Kaiser decimator, for `seconds`: (intervals, oversampling, output).
+fn refined_one_string(seconds: f64) -> Option<(usize, usize, Vec<f64>)> {
     let settings = settings_at(Quality::Reference);
     let tier = Quality::Reference.fd_tier()?;
     let (intervals, oversample) = (tier.intervals * REFINEMENT, tier.oversample * REFINEMENT);
@@ -386,47 +393,66 @@ fn refined_reference(reference: &BenchResult, seconds: f64) -> Option<ReferenceR
             output.push(f64::from(sample as f32));
         }
     }
-    let (cents_error_max, spectral_distance_db, formant_error) = errors_against(
-        &reference.output,
-        reference.fundamental_hz,
-        &output,
-        settings.fundamental_hz,
-    );
-    Some(ReferenceRefinement {
-        intervals,
-        oversample,
-        cents_error_max,
-        spectral_distance_db,
-        formant_error,
-    })
+    Some((intervals, oversample, output))
 }
 
-/// [`refined_reference`] for the one-string scene of `results`, if it was run.
+/// Renders [`refined_one_string`] and measures the one-string scene's tanpura renders in
+/// `results` against it, if the scene was run.
 pub fn run_reference_refinement(
     results: &[BenchResult],
     seconds: f64,
 ) -> Option<ReferenceRefinement> {
-    let reference = results
+    let one_string: Vec<&BenchResult> = results
         .iter()
-        .find(|r| r.voice == "tanpura" && r.tier == "reference" && r.scene == "one-string")?;
-    eprintln!("bench: one-string, reference against a grid {REFINEMENT} times finer ...");
-    refined_reference(reference, seconds)
+        .filter(|r| r.voice == "tanpura" && r.scene == "one-string")
+        .collect();
+    if one_string.is_empty() {
+        return None;
+    }
+    eprintln!("bench: one-string, against a reference grid {REFINEMENT} times finer ...");
+    let (intervals, oversample, refined) = refined_one_string(seconds)?;
+    let fundamental = settings_at(Quality::Reference).fundamental_hz;
+    let tiers = one_string
+        .iter()
+        .map(|result| {
+            let (cents_error_max, spectral_distance_db, formant_error) =
+                errors_against(&result.output, result.fundamental_hz, &refined, fundamental);
+            AgainstRefinement {
+                tier: result.tier,
+                cents_error_max,
+                spectral_distance_db,
+                formant_error,
+            }
+        })
+        .collect();
+    Some(ReferenceRefinement {
+        intervals,
+        oversample,
+        tiers,
+    })
 }
 
-/// The markdown paragraph of [`ReferenceRefinement`].
+/// The markdown table of [`ReferenceRefinement`].
 pub fn refinement_markdown(refinement: &ReferenceRefinement) -> String {
-    format!(
-        "
-The reference tier's own error on the one-string measures: its render against the \
-         seed's scheme on a grid {REFINEMENT} times finer (N = {}, {}× oversampling; tuned, \
-         plucked and picked up as the scene's voice) lies {:.2} cents (10 partials), {:.1} dB \
-         (spectral distance) and {:.1} % (formant error) from it.\n",
-        refinement.intervals,
-        refinement.oversample,
-        refinement.cents_error_max,
-        refinement.spectral_distance_db,
-        100.0 * refinement.formant_error,
-    )
+    let mut text = format!(
+        "\nThe one-string scene against the seed's scheme on a grid {REFINEMENT} times finer \
+         (N = {}, {}× oversampling; tuned, plucked and picked up as the reference tier's voice): \
+         the reference tier's row is its own discretisation error.\n\n\
+         | tier | cents error (10 partials) | spectral distance | formant error |\n\
+         |---|---|---|---|\n",
+        refinement.intervals, refinement.oversample,
+    );
+    for row in &refinement.tiers {
+        let _ = writeln!(
+            text,
+            "| {} | {:.2} | {:.1} dB | {:.1} % |",
+            row.tier,
+            row.cents_error_max,
+            row.spectral_distance_db,
+            100.0 * row.formant_error
+        );
+    }
+    text
 }
 
 fn settings_at(quality: Quality) -> VoiceSettings {
@@ -834,14 +860,25 @@ pub fn to_json(
         })
         .collect();
     let refinement = refinement.map_or("null".to_string(), |r| {
+        let tiers: Vec<String> = r
+            .tiers
+            .iter()
+            .map(|row| {
+                format!(
+                    "{{\"tier\": \"{}\", \"cents_error_max\": {}, \"spectral_distance_db\": {}, \
+                     \"formant_error\": {}}}",
+                    row.tier,
+                    json_number(Some(row.cents_error_max)),
+                    json_number(Some(row.spectral_distance_db)),
+                    json_number(Some(row.formant_error)),
+                )
+            })
+            .collect();
         format!(
-            "{{\"intervals\": {}, \"oversample\": {}, \"cents_error_max\": {}, \
-             \"spectral_distance_db\": {}, \"formant_error\": {}}}",
+            "{{\"intervals\": {}, \"oversample\": {}, \"tiers\": [{}]}}",
             r.intervals,
             r.oversample,
-            json_number(Some(r.cents_error_max)),
-            json_number(Some(r.spectral_distance_db)),
-            json_number(Some(r.formant_error)),
+            tiers.join(", ")
         )
     });
     format!(
@@ -981,22 +1018,23 @@ mod tests {
             fundamental_hz: settings.fundamental_hz,
         };
         let reference = measure(&mut scene, seconds, label);
-        let refinement = refined_reference(&reference, seconds).expect("the reference is FD");
+        let refinement = run_reference_refinement(&[reference], seconds).expect("one string ran");
         assert_eq!((refinement.intervals, refinement.oversample), (800, 16));
+        let row = refinement.tiers[0];
+        assert_eq!(row.tier, "reference");
         // The same string, tuned the same: its partials within cents of the reference's (10.2
         // measured over 0.5–1 s, 2.5 over the bench's 3 s: the pitches part most early in the
         // note); a different grid: its spectrum measurably apart.
+        assert!(row.cents_error_max < 20.0, "{}", row.cents_error_max);
         assert!(
-            refinement.cents_error_max < 20.0,
+            row.spectral_distance_db > 1.0 && row.spectral_distance_db < 20.0,
             "{}",
-            refinement.cents_error_max
-        );
-        assert!(
-            refinement.spectral_distance_db > 1.0 && refinement.spectral_distance_db < 20.0,
-            "{}",
-            refinement.spectral_distance_db
+            row.spectral_distance_db
         );
         let json = to_json("machine", &[], &[], &[], Some(&refinement));
-        assert!(json.contains("\"reference_refinement\": {\"intervals\": 800"));
+        assert!(json.contains(
+            "\"reference_refinement\": {\"intervals\": 800, \"oversample\": 16, \"tiers\": \
+             [{\"tier\": \"reference\""
+        ));
     }
 }
