@@ -33,134 +33,41 @@
 use javari_core::analysis::cents;
 use javari_core::analysis::listening::{compare, sustained_pitch_hz};
 use javari_core::analysis::playing_range::NOTE_SECONDS;
-use javari_core::tanpura::excitation::Pluck;
-use javari_core::tanpura::fd::decimator::Decimator;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
-use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
+use javari_core::tanpura::modal::ModalString;
 use std::sync::Mutex;
 
-const OUTPUT_RATE_HZ: f64 = 44_100.0;
+#[path = "support/schemes.rs"]
+mod schemes;
+use schemes::{Scheme, OUTPUT_RATE_HZ};
+
 const KEYS: [u8; 6] = [49, 50, 51, 52, 53, 54];
 const VELOCITIES: [u8; 4] = [1, 40, 80, 127];
 /// The index of N = 800 at 16× among the plucked schemes: the yardstick of part 3.
 const FINE: usize = 2;
 
-/// A discretisation of the seed's string at a given tension.
-#[derive(Clone, Copy)]
-enum Scheme {
-    /// FD with `intervals` and `oversampling` × 44.1 kHz.
-    Fd(usize, usize),
-    /// Modal (f64) with bridge points `spacing` apart (the thread's half of it), `residual`
-    /// residual modes and the static compliance frozen in (`flexibility`).
-    Modal(f64, usize, bool),
-}
-
-impl Scheme {
-    fn name(self) -> String {
-        match self {
-            Scheme::Fd(intervals, oversampling) => format!("FD N = {intervals}, {oversampling}x"),
-            Scheme::Modal(spacing, residual, flexibility) => format!(
-                "modal, {:.2} mm, {}",
-                spacing * 1e3,
-                match (residual, flexibility) {
-                    (0, false) => "kept modes only".to_owned(),
-                    (_, true) => "static compliance".to_owned(),
-                    (residual, false) => format!("{residual} residual modes"),
-                }
-            ),
+/// The deepest bridge gap of `scheme`'s string at rest at `tension_n`, µm (positive: into the
+/// crest).
+fn deepest_rest_gap_um(scheme: Scheme, tension_n: f64) -> f64 {
+    let deepest = |gaps: &mut dyn Iterator<Item = f64>| gaps.fold(f64::MIN, f64::max) * 1e6;
+    match scheme {
+        Scheme::Fd(intervals, oversampling) => {
+            let string = FdString::new(Scheme::fd_config(intervals, oversampling, Some(tension_n)));
+            let grid = string.bridge_grid();
+            deepest(
+                &mut (0..grid.len())
+                    .map(|i| grid.heights_m()[i] - grid.interpolate(string.displacement_m(), i)),
+            )
         }
-    }
-
-    fn fd_config(intervals: usize, oversampling: usize, tension_n: f64) -> FdStringConfig {
-        let mut config = FdStringConfig {
-            intervals,
-            time_step_s: 1.0 / (OUTPUT_RATE_HZ * oversampling as f64),
-            ..FdStringConfig::REFERENCE
-        };
-        config.string.tension_n = tension_n;
-        config
-    }
-
-    fn modal_config(
-        spacing: f64,
-        residual: usize,
-        flexibility: bool,
-        tension_n: f64,
-    ) -> ModalStringConfig {
-        let mut config = ModalStringConfig {
-            bridge_point_spacing_m: spacing,
-            thread_point_spacing_m: 0.5 * spacing,
-            residual_modes: residual,
-            static_flexibility: flexibility,
-            ..ModalStringConfig::REFERENCE
-        };
-        config.string.tension_n = tension_n;
-        config
-    }
-
-    /// The deepest bridge gap at rest, µm (positive: into the crest).
-    fn deepest_rest_gap_um(self, tension_n: f64) -> f64 {
-        let deepest = |gaps: &mut dyn Iterator<Item = f64>| gaps.fold(f64::MIN, f64::max) * 1e6;
-        match self {
-            Scheme::Fd(intervals, oversampling) => {
-                let string = FdString::new(Self::fd_config(intervals, oversampling, tension_n));
-                let grid = string.bridge_grid();
-                deepest(
-                    &mut (0..grid.len()).map(|i| {
-                        grid.heights_m()[i] - grid.interpolate(string.displacement_m(), i)
-                    }),
-                )
-            }
-            Scheme::Modal(spacing, residual, flexibility) => {
-                let string: ModalString<f64> = ModalString::new(Self::modal_config(
-                    spacing,
-                    residual,
-                    flexibility,
-                    tension_n,
-                ));
-                let bridge = string.bridge_point_count();
-                deepest(&mut string.gaps_m()[..bridge].iter().copied())
-            }
-        }
-    }
-
-    /// The nut force at 44.1 kHz for a grid note's length ([`NOTE_SECONDS`]), plucked at
-    /// `velocity` (FD through the tiers' Kaiser decimator).
-    fn pluck_nut_force(self, tension_n: f64, velocity: f64) -> Vec<f64> {
-        let pluck = Pluck {
-            amplitude_m: Pluck::default().amplitude_m * velocity,
-            ..Pluck::default()
-        };
-        let samples = (NOTE_SECONDS * OUTPUT_RATE_HZ).round() as usize;
-        match self {
-            Scheme::Fd(intervals, oversampling) => {
-                let mut string = FdString::new(Self::fd_config(intervals, oversampling, tension_n));
-                string.pluck(&pluck);
-                let mut decimator = Decimator::new(oversampling);
-                let mut output = Vec::with_capacity(samples);
-                while output.len() < samples {
-                    string.step();
-                    if let Some(sample) = decimator.push(string.nut_force_n()) {
-                        output.push(sample);
-                    }
-                }
-                output
-            }
-            Scheme::Modal(spacing, residual, flexibility) => {
-                let mut string: ModalString<f64> = ModalString::new(Self::modal_config(
-                    spacing,
-                    residual,
-                    flexibility,
-                    tension_n,
-                ));
-                string.pluck(&pluck);
-                (0..samples)
-                    .map(|_| {
-                        string.step();
-                        string.nut_force_n()
-                    })
-                    .collect()
-            }
+        Scheme::Modal(spacing, residual, flexibility) => {
+            let string: ModalString<f64> = ModalString::new(Scheme::modal_config(
+                spacing,
+                residual,
+                flexibility,
+                Some(tension_n),
+            ));
+            let bridge = string.bridge_point_count();
+            deepest(&mut string.gaps_m()[..bridge].iter().copied())
         }
     }
 }
@@ -196,7 +103,7 @@ fn main() {
     for scheme in static_schemes {
         print!("| {} |", scheme.name());
         for key in KEYS {
-            print!(" {:+.2} |", scheme.deepest_rest_gap_um(tension_of(key)));
+            print!(" {:+.2} |", deepest_rest_gap_um(scheme, tension_of(key)));
         }
         println!();
     }
@@ -232,7 +139,11 @@ fn main() {
                 let forces: Vec<Vec<f64>> = VELOCITIES
                     .iter()
                     .map(|&velocity| {
-                        scheme.pluck_nut_force(tension_of(key), f64::from(velocity) / 127.0)
+                        scheme.pluck_nut_force(
+                            Some(tension_of(key)),
+                            f64::from(velocity) / 127.0,
+                            NOTE_SECONDS,
+                        )
                     })
                     .collect();
                 renders.lock().unwrap()[s][k] = forces;

@@ -21,80 +21,15 @@ use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz
 use javari_core::analysis::{
     cents, first_partials_hz, peak_frequency_hz, third_octave_distance_db,
 };
-use javari_core::tanpura::excitation::Pluck;
-use javari_core::tanpura::fd::decimator::Decimator;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
 use std::sync::Mutex;
 
+#[path = "support/schemes.rs"]
+mod schemes;
+use schemes::{Scheme, OUTPUT_RATE_HZ};
+
 const SECONDS: f64 = 3.0;
-const OUTPUT_RATE_HZ: f64 = 44_100.0;
-
-#[derive(Clone, Copy)]
-enum Scheme {
-    /// FD with `intervals` at `oversampling` × 44.1 kHz.
-    Fd(usize, usize),
-    /// Modal (f64) with bridge points `spacing` apart (the thread's half of it), `residual`
-    /// residual modes and the static compliance frozen in (`flexibility`).
-    Modal(f64, usize, bool),
-}
-
-impl Scheme {
-    fn name(self) -> String {
-        match self {
-            Scheme::Fd(200, 4) => "FD N = 200, 4x (the reference)".to_owned(),
-            Scheme::Fd(intervals, oversampling) => format!("FD N = {intervals}, {oversampling}x"),
-            Scheme::Modal(spacing, 0, false) => {
-                format!("modal, {:.2} mm, kept modes only", spacing * 1e3)
-            }
-            Scheme::Modal(spacing, 0, true) => {
-                format!("modal, {:.2} mm, static flexibility", spacing * 1e3)
-            }
-            Scheme::Modal(spacing, residual, _) => {
-                format!("modal, {:.2} mm, {residual} residual modes", spacing * 1e3)
-            }
-        }
-    }
-
-    fn render(self) -> Vec<f64> {
-        let samples = (SECONDS * OUTPUT_RATE_HZ) as usize;
-        match self {
-            Scheme::Fd(intervals, oversampling) => {
-                let mut string = FdString::new(FdStringConfig {
-                    intervals,
-                    time_step_s: 1.0 / (OUTPUT_RATE_HZ * oversampling as f64),
-                    ..FdStringConfig::REFERENCE
-                });
-                string.pluck(&Pluck::default());
-                let mut decimator = Decimator::new(oversampling);
-                let mut output = Vec::with_capacity(samples);
-                while output.len() < samples {
-                    string.step();
-                    if let Some(sample) = decimator.push(string.nut_force_n()) {
-                        output.push(sample);
-                    }
-                }
-                output
-            }
-            Scheme::Modal(spacing, residual_modes, static_flexibility) => {
-                let mut string: ModalString<f64> = ModalString::new(ModalStringConfig {
-                    bridge_point_spacing_m: spacing,
-                    thread_point_spacing_m: 0.5 * spacing,
-                    residual_modes,
-                    static_flexibility,
-                    ..ModalStringConfig::REFERENCE
-                });
-                string.pluck(&Pluck::default());
-                (0..samples)
-                    .map(|_| {
-                        string.step();
-                        string.nut_force_n()
-                    })
-                    .collect()
-            }
-        }
-    }
-}
 
 /// The bench's three one-string measures of `output` against `reference` (fundamental
 /// `fundamental_hz` for both: the strings are the same, untuned).
@@ -138,7 +73,7 @@ fn main() {
                     index
                 };
                 let Some(index) = index else { break };
-                let output = schemes[index].render();
+                let output = schemes[index].pluck_nut_force(None, 1.0, SECONDS);
                 renders.lock().unwrap()[index] = output;
             });
         }

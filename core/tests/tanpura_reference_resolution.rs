@@ -7,7 +7,7 @@
 use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz};
 use javari_core::analysis::third_octave_distance_db;
 use javari_core::tanpura::excitation::Pluck;
-use javari_core::tanpura::fd::decimator::Decimator;
+use javari_core::tanpura::fd::decimator::render_decimated;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 
 const OUTPUT_RATE_HZ: f64 = 44_100.0;
@@ -22,16 +22,10 @@ fn render(intervals: usize, oversampling: usize) -> Vec<f64> {
         ..FdStringConfig::REFERENCE
     });
     string.pluck(&Pluck::default());
-    let mut decimator = Decimator::new(oversampling);
-    let samples = (SECONDS * OUTPUT_RATE_HZ) as usize;
-    let mut output = Vec::with_capacity(samples);
-    while output.len() < samples {
+    render_decimated(oversampling, (SECONDS * OUTPUT_RATE_HZ) as usize, || {
         string.step();
-        if let Some(sample) = decimator.push(string.nut_force_n()) {
-            output.push(sample);
-        }
-    }
-    output
+        string.nut_force_n()
+    })
 }
 
 /// Spectral distance (dB) and formant error (fraction) of `output` against `reference`.

@@ -21,7 +21,7 @@ use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice,
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
 use javari_core::newton::NewtonStats;
 use javari_core::tanpura::excitation::Pluck;
-use javari_core::tanpura::fd::decimator::Decimator;
+use javari_core::tanpura::fd::decimator::render_decimated;
 use javari_core::tanpura::fd::FdString;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::tier_string::weighted_pickup_n;
@@ -378,21 +378,19 @@ fn refined_one_string(seconds: f64) -> Option<(usize, usize, Vec<f64>)> {
         string.set_config(config);
     }
     string.pluck(&Pluck::default());
-    let mut decimator = Decimator::new(oversample);
     let samples = (seconds * SAMPLE_RATE) as usize;
-    let mut output = Vec::with_capacity(samples);
-    while output.len() < samples {
+    let output = render_decimated(oversample, samples, || {
         string.step();
-        let pickup = weighted_pickup_n(
+        weighted_pickup_n(
             settings.nut_pickup_weight,
             string.nut_force_n() - string.rest_nut_force_n(),
             string.bridge_force_n() - string.rest_bridge_force_n(),
-        );
-        if let Some(sample) = decimator.push(pickup) {
-            // The voice's output is f32.
-            output.push(f64::from(sample as f32));
-        }
-    }
+        )
+    })
+    .into_iter()
+    // The voice's output is f32.
+    .map(|sample| f64::from(sample as f32))
+    .collect();
     Some((intervals, oversample, output))
 }
 

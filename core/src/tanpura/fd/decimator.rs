@@ -130,6 +130,25 @@ impl Decimator {
     }
 }
 
+/// A whole render at the output rate: calls `next_internal` (one internal-rate step, returning
+/// its sample) `factor` times per output sample through a fresh [`Decimator`] by `factor`, for
+/// `samples` output samples. Allocates: for offline tools (the bench, the examples, tests), not
+/// the audio thread.
+pub fn render_decimated(
+    factor: usize,
+    samples: usize,
+    mut next_internal: impl FnMut() -> f64,
+) -> Vec<f64> {
+    let mut decimator = Decimator::new(factor);
+    let mut output = Vec::with_capacity(samples);
+    while output.len() < samples {
+        if let Some(sample) = decimator.push(next_internal()) {
+            output.push(sample);
+        }
+    }
+    output
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
