@@ -35,11 +35,9 @@ use javari_core::analysis::listening::{compare, sustained_pitch_hz};
 use javari_core::analysis::playing_range::NOTE_SECONDS;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::ModalString;
-use std::sync::Mutex;
-
 #[path = "support/schemes.rs"]
 mod schemes;
-use schemes::{Scheme, OUTPUT_RATE_HZ};
+use schemes::{on_all_cores, Scheme, OUTPUT_RATE_HZ};
 
 const KEYS: [u8; 6] = [49, 50, 51, 52, 53, 54];
 const VELOCITIES: [u8; 4] = [1, 40, 80, 127];
@@ -122,35 +120,23 @@ fn main() {
         .flat_map(|s| (0..KEYS.len()).map(move |k| (s, k)))
         .collect();
     jobs.sort_by_key(|&(s, _)| usize::from(s != FINE));
-    let next = Mutex::new(0usize);
-    let renders = Mutex::new(vec![vec![Vec::new(); KEYS.len()]; dynamic_schemes.len()]);
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| loop {
-                let job = {
-                    let mut next = next.lock().unwrap();
-                    let job = jobs.get(*next).copied();
-                    *next += 1;
-                    job
-                };
-                let Some((s, k)) = job else { break };
-                let (scheme, key) = (dynamic_schemes[s], KEYS[k]);
-                let forces: Vec<Vec<f64>> = VELOCITIES
-                    .iter()
-                    .map(|&velocity| {
-                        scheme.pluck_nut_force(
-                            Some(tension_of(key)),
-                            f64::from(velocity) / 127.0,
-                            NOTE_SECONDS,
-                        )
-                    })
-                    .collect();
-                renders.lock().unwrap()[s][k] = forces;
-            });
-        }
+    let forces = on_all_cores(&jobs, |&(s, k)| {
+        let (scheme, key) = (dynamic_schemes[s], KEYS[k]);
+        VELOCITIES
+            .iter()
+            .map(|&velocity| {
+                scheme.pluck_nut_force(
+                    Some(tension_of(key)),
+                    f64::from(velocity) / 127.0,
+                    NOTE_SECONDS,
+                )
+            })
+            .collect::<Vec<Vec<f64>>>()
     });
-    let renders = renders.into_inner().unwrap();
+    let mut renders = vec![vec![Vec::new(); KEYS.len()]; dynamic_schemes.len()];
+    for (&(s, k), forces) in jobs.iter().zip(forces) {
+        renders[s][k] = forces;
+    }
     let header = || {
         print!("| scheme |");
         for key in KEYS {

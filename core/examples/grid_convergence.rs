@@ -23,11 +23,9 @@ use javari_core::analysis::{
 };
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
-use std::sync::Mutex;
-
 #[path = "support/schemes.rs"]
 mod schemes;
-use schemes::{Scheme, OUTPUT_RATE_HZ};
+use schemes::{on_all_cores, Scheme, OUTPUT_RATE_HZ};
 
 const SECONDS: f64 = 3.0;
 
@@ -60,25 +58,13 @@ fn main() {
     ];
     // The longest render (N = 800) first, so that the two cores finish together.
     let order = [3, 0, 1, 2, 4, 5, 6, 7, 8];
-    let next = Mutex::new(0usize);
-    let renders = Mutex::new(vec![Vec::new(); schemes.len()]);
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| loop {
-                let index = {
-                    let mut next = next.lock().unwrap();
-                    let index = order.get(*next).copied();
-                    *next += 1;
-                    index
-                };
-                let Some(index) = index else { break };
-                let output = schemes[index].pluck_nut_force(None, 1.0, SECONDS);
-                renders.lock().unwrap()[index] = output;
-            });
-        }
+    let in_order = on_all_cores(&order, |&index| {
+        schemes[index].pluck_nut_force(None, 1.0, SECONDS)
     });
-    let renders = renders.into_inner().unwrap();
+    let mut renders = vec![Vec::new(); schemes.len()];
+    for (&index, output) in order.iter().zip(in_order) {
+        renders[index] = output;
+    }
     let start = (0.5 * OUTPUT_RATE_HZ) as usize;
     let fundamental = peak_frequency_hz(&renders[0][start..], OUTPUT_RATE_HZ, 120.0, 260.0);
     println!(
