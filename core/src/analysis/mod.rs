@@ -186,11 +186,9 @@ pub fn band_power(spectrum: &[f64], bin_hz: f64, low_hz: f64, high_hz: f64) -> f
         .sum()
 }
 
-/// The bench's one-string measures (`cargo xtask bench`): the first `count` partials and a
-/// timbre distance between two renders.
-///
 /// The frequencies of the first `count` partials of `signal` from 0.5 s on, each the peak within
-/// ±3 % of n·`fundamental_hz`, Hz.
+/// ±3 % of n·`fundamental_hz`, Hz: the cents measure of the bench's one-string scene
+/// (`cargo xtask bench`).
 pub fn first_partials_hz(
     signal: &[f64],
     sample_rate_hz: f64,
@@ -358,5 +356,41 @@ mod tests {
 
     fn spectrum_centroid_check(spectrum: &[f64]) -> f64 {
         spectral_centroid_hz(spectrum, 10.0, 0.0, 1000.0)
+    }
+
+    /// A sum of sines at 100, 200, … Hz with the given amplitudes, 2 s at 8 kHz.
+    fn harmonics(amplitudes: &[f64]) -> Vec<f64> {
+        (0..16_000)
+            .map(|j| {
+                let t = j as f64 / 8_000.0;
+                amplitudes
+                    .iter()
+                    .enumerate()
+                    .map(|(n, a)| a * (2.0 * PI * 100.0 * (n + 1) as f64 * t).sin())
+                    .sum()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn first_partials_are_found_where_they_are() {
+        let partials = first_partials_hz(&harmonics(&[1.0, 0.5, 0.3]), 8_000.0, 100.0, 3);
+        for (n, partial) in partials.iter().enumerate() {
+            assert!(
+                (partial - 100.0 * (n + 1) as f64).abs() < 0.01,
+                "{partials:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_third_octave_distance_is_zero_to_itself_and_counts_a_missing_band() {
+        let full = harmonics(&[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5]);
+        assert_eq!(third_octave_distance_db(&full, &full, 8_000.0), 0.0);
+        // Without its 1 kHz partial, 6 dB below the loudest: that band counts as the 60 dB
+        // floor below the loudest band, 54 dB off, among the bands within 60 dB of it.
+        let missing = harmonics(&[1.0]);
+        let distance = third_octave_distance_db(&missing, &full, 8_000.0);
+        assert!(distance > 10.0, "{distance}");
     }
 }
