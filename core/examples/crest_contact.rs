@@ -21,7 +21,7 @@
 //! modes alone strike the crest to the end, residual modes settle on it) is asserted by
 //! `core/tests/tanpura_modal.rs`.
 
-use javari_core::analysis::power_spectrum;
+use javari_core::analysis::{power_spectrum, third_octave_edges_hz, third_octave_levels_db};
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
@@ -167,34 +167,13 @@ fn high_band() {
     }
 }
 
-/// Third-octave band levels (dB) of 4096-sample frames, 40 Hz to 16 kHz, as the bench measures
-/// its spectral distance; returns the bands' lower edges and the levels per frame.
+/// The bench's third-octave band levels (`analysis::third_octave_levels_db`): the bands' lower
+/// edges and the levels per frame.
 fn band_levels(output: &[f64]) -> (Vec<f64>, Vec<Vec<f64>>) {
-    const FRAME: usize = 4096;
-    let bin_hz = 44_100.0 / FRAME as f64;
-    let mut edges = vec![40.0f64];
-    while *edges.last().unwrap_or(&16_000.0) < 16_000.0 {
-        let next = edges[edges.len() - 1] * 2f64.powf(1.0 / 3.0);
-        edges.push(next);
-    }
-    let levels = (0..output.len() / FRAME)
-        .map(|frame| {
-            let spectrum = power_spectrum(output, frame * FRAME, FRAME, FRAME);
-            edges
-                .windows(2)
-                .map(|band| {
-                    let power: f64 = spectrum
-                        .iter()
-                        .enumerate()
-                        .filter(|(k, _)| (band[0]..=band[1]).contains(&(*k as f64 * bin_hz)))
-                        .map(|(_, p)| p)
-                        .sum();
-                    10.0 * (power + 1e-30).log10()
-                })
-                .collect()
-        })
-        .collect();
-    (edges, levels)
+    (
+        third_octave_edges_hz(),
+        third_octave_levels_db(output, 44_100.0),
+    )
 }
 
 /// The live tier's third-octave levels above 1 kHz against the reference's, averaged over the

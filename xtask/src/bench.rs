@@ -25,7 +25,7 @@ use javari_core::tanpura::fd::decimator::render_decimated;
 use javari_core::tanpura::fd::FdString;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::tier_string::weighted_pickup_n;
-use javari_core::tanpura::{FirstString, Tanpura, TanpuraVoice, VoiceSettings};
+use javari_core::tanpura::{FirstString, Tanpura, TanpuraVoice, VoiceSettings, TUNING_PASSES};
 use std::error::Error;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -369,7 +369,8 @@ fn refined_one_string(seconds: f64) -> Option<(usize, usize, Vec<f64>)> {
     config.intervals = intervals;
     config.time_step_s = 1.0 / (SAMPLE_RATE * oversample as f64);
     let mut string = FdString::new(config);
-    for _ in 0..2 {
+    // The voice's tuning: passes of T ← T (f / f_lin)² on the linearised fundamental.
+    for _ in 0..TUNING_PASSES {
         let linearised = string.linearised_fundamental_hz();
         if !(linearised.is_finite() && linearised > 0.0) {
             return None;

@@ -208,9 +208,21 @@ pub fn first_partials_hz(
 /// Frame length of [`third_octave_levels_db`], samples.
 pub const THIRD_OCTAVE_FRAME: usize = 4096;
 
-/// Third-octave band levels (dB) of each [`THIRD_OCTAVE_FRAME`]-sample frame, 40 Hz to 16 kHz.
+/// The edges of [`third_octave_levels_db`]'s bands, Hz: from 40 Hz up by thirds of an octave,
+/// the last at or above 16 kHz (band k spans edges k and k + 1).
+pub fn third_octave_edges_hz() -> Vec<f64> {
+    let mut edges = vec![40.0f64];
+    while edges[edges.len() - 1] < 16_000.0 {
+        edges.push(edges[edges.len() - 1] * 2f64.powf(1.0 / 3.0));
+    }
+    edges
+}
+
+/// Third-octave band levels (dB) of each [`THIRD_OCTAVE_FRAME`]-sample frame, 40 Hz to 16 kHz
+/// ([`third_octave_edges_hz`]).
 pub fn third_octave_levels_db(signal: &[f64], sample_rate_hz: f64) -> Vec<Vec<f64>> {
     let bin = sample_rate_hz / THIRD_OCTAVE_FRAME as f64;
+    let edges = third_octave_edges_hz();
     (0..signal.len() / THIRD_OCTAVE_FRAME)
         .map(|frame| {
             let spectrum = power_spectrum(
@@ -219,14 +231,10 @@ pub fn third_octave_levels_db(signal: &[f64], sample_rate_hz: f64) -> Vec<Vec<f6
                 THIRD_OCTAVE_FRAME,
                 THIRD_OCTAVE_FRAME,
             );
-            let mut levels = Vec::new();
-            let mut low = 40.0;
-            while low < 16_000.0 {
-                let high = low * 2f64.powf(1.0 / 3.0);
-                levels.push(10.0 * (band_power(&spectrum, bin, low, high) + 1e-30).log10());
-                low = high;
-            }
-            levels
+            edges
+                .windows(2)
+                .map(|band| 10.0 * (band_power(&spectrum, bin, band[0], band[1]) + 1e-30).log10())
+                .collect()
         })
         .collect()
 }

@@ -32,5 +32,5 @@ pub mod voice;
 pub use instrument::{FirstString, Tanpura};
 pub use voice::{
     reference_fundamental_hz, tension_for_pitch_n, SettingsError, TanpuraVoice, VoiceSettings,
-    MAX_OVERSAMPLE, SLEEP_ENERGY_J,
+    MAX_OVERSAMPLE, SLEEP_ENERGY_J, TUNING_PASSES,
 };

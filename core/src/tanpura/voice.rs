@@ -34,8 +34,9 @@ use std::fmt;
 pub const SLEEP_ENERGY_J: f64 = 1e-12;
 /// How often (in output samples) a voice checks whether it may sleep.
 const SLEEP_CHECK_INTERVAL: u32 = 256;
-/// Passes of the tension correction that tunes a string (see `configure_string`).
-const TUNING_PASSES: usize = 2;
+/// Passes of the tension correction `T ← T (f / f_lin)²` that tunes a string by its linearised
+/// fundamental (see `TanpuraVoice::configure_string`).
+pub const TUNING_PASSES: usize = 2;
 /// Largest internal oversampling factor.
 pub const MAX_OVERSAMPLE: usize = 8;
 

@@ -26,8 +26,8 @@
 //! response per contact node) recovers the whole step, `s = s_lin + Σ_j f_j A⁻¹ e_j`, over the
 //! nodes that carry a force: one banded solve per time step (the predictor) and no second one.
 //! `A` is banded and diagonally dominant, so each column decays geometrically away from its
-//! node; the recovery reads it only where it is above 2⁻⁶⁰ of its peak (on the seed's string 17
-//! nodes either side of the contact node, of 199; test
+//! node; the recovery reads it only where it is above 2⁻⁶⁰ of its peak (on the seed's string
+//! within 17 nodes of the contact node, of 199; test
 //! `reference_grid_columns_are_significant_near_their_node_only`), which leaves out less than the
 //! round-off of the correction ([`RESPONSE_CUTOFF`]).
 //! Energy stability is untouched: the accepted `s` solves the same discrete equations (to the
