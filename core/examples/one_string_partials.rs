@@ -1,0 +1,100 @@
+//! The bench's one-string scene, partial by partial: each tier's first ten partials against the
+//! reference tier's, in cents, with the three tunings a string can have: the linearised tuning
+//! the bench's scene uses (`TanpuraVoice::new`), the as-played tuning the plugin and `render`
+//! use by default (velocities 40 and 110 centred, `tanpura/as_played.rs`), and the as-played
+//! tuning at the scene's own pluck (velocity 127). `cargo run --release -p javari-core --example
+//! one_string_partials` (about 30 s). Prints, per tuning and tier, the calibration offset,
+//! the fundamental, the third-octave distance to the reference (dB) and the cents of each partial
+//! (`analysis::first_partials_hz`, the bench's measure, 0.5–3 s).
+
+use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
+use javari_core::tanpura::as_played::{as_played_offset_cents, NOTE_VELOCITIES};
+use javari_core::tanpura::excitation::Pluck;
+use javari_core::tanpura::quality::Quality;
+use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
+
+const SAMPLE_RATE: f64 = 44_100.0;
+const SECONDS: f64 = 3.0;
+const BLOCK: usize = 64;
+const PARTIALS: usize = 10;
+
+/// How the scene's string is tuned.
+#[derive(Clone, Copy)]
+enum Tuning {
+    Linearised,
+    AsPlayed([f64; 2]),
+}
+
+impl Tuning {
+    fn name(self) -> &'static str {
+        match self {
+            Tuning::Linearised => "linearised (the bench's scene)",
+            Tuning::AsPlayed(velocities) if velocities == NOTE_VELOCITIES => {
+                "as played, velocities 40 and 110 (the plugin's default)"
+            }
+            Tuning::AsPlayed(_) => "as played at the scene's pluck (velocity 127)",
+        }
+    }
+}
+
+/// One tier's render of the scene: the offset its tuning found (cents) and the output.
+fn render(quality: Quality, tuning: Tuning) -> (f64, Vec<f64>) {
+    let nominal = VoiceSettings {
+        quality,
+        ..VoiceSettings::default()
+    };
+    let offset = match tuning {
+        Tuning::Linearised => 0.0,
+        Tuning::AsPlayed(velocities) => {
+            as_played_offset_cents(&nominal, &Pluck::default(), velocities, SAMPLE_RATE)
+        }
+    };
+    let settings = VoiceSettings {
+        fundamental_hz: nominal.fundamental_hz * (offset / 1200.0).exp2(),
+        ..nominal
+    };
+    let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
+    voice.pluck(&Pluck::default());
+    let blocks = (SECONDS * SAMPLE_RATE) as usize / BLOCK;
+    let mut output = Vec::with_capacity(blocks * BLOCK);
+    let mut block = [0.0f32; BLOCK];
+    for _ in 0..blocks {
+        voice.process(&mut block);
+        output.extend(block.iter().map(|&sample| f64::from(sample)));
+    }
+    (offset, output)
+}
+
+fn main() {
+    let nominal_hz = VoiceSettings::default().fundamental_hz;
+    for tuning in [
+        Tuning::Linearised,
+        Tuning::AsPlayed(NOTE_VELOCITIES),
+        Tuning::AsPlayed([1.0, 1.0]),
+    ] {
+        println!("{}", tuning.name());
+        let (reference_offset, reference) = render(Quality::Reference, tuning);
+        let reference_partials = first_partials_hz(&reference, SAMPLE_RATE, nominal_hz, PARTIALS);
+        for quality in Quality::ALL.into_iter().rev() {
+            let (offset, output) = if quality == Quality::Reference {
+                (reference_offset, reference.clone())
+            } else {
+                render(quality, tuning)
+            };
+            let partials = first_partials_hz(&output, SAMPLE_RATE, nominal_hz, PARTIALS);
+            let deviations: Vec<String> = partials
+                .iter()
+                .zip(&reference_partials)
+                .map(|(mine, theirs)| format!("{:+.2}", cents(*mine, *theirs)))
+                .collect();
+            println!(
+                "  {:<9} offset {:+7.3} cents, f1 {:.3} Hz, distance {:5.2} dB | {}",
+                quality.name(),
+                offset,
+                partials[0],
+                third_octave_distance_db(&output, &reference, SAMPLE_RATE),
+                deviations.join(" ")
+            );
+        }
+    }
+}
