@@ -7,6 +7,7 @@
 //! the fundamental, the third-octave distance to the reference (dB) and the cents of each partial
 //! (`analysis::first_partials_hz`, the bench's measure, 0.5–3 s).
 
+use javari_core::analysis::refined::refined_reference_pluck;
 use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::tanpura::as_played::{as_played_offset_cents, NOTE_VELOCITIES};
 use javari_core::tanpura::excitation::Pluck;
@@ -37,8 +38,22 @@ impl Tuning {
     }
 }
 
+/// The scene's pluck at `velocity` (0–1).
+fn pluck_at(velocity: f64) -> Pluck {
+    let pluck = Pluck::default();
+    Pluck {
+        amplitude_m: pluck.amplitude_m * velocity,
+        ..pluck
+    }
+}
+
 /// One tier's render of the scene: the offset its tuning found (cents) and the output.
 fn render(quality: Quality, tuning: Tuning) -> (f64, Vec<f64>) {
+    render_at(quality, tuning, 1.0)
+}
+
+/// [`render`] with the pluck at `velocity` (0–1).
+fn render_at(quality: Quality, tuning: Tuning, velocity: f64) -> (f64, Vec<f64>) {
     let nominal = VoiceSettings {
         quality,
         ..VoiceSettings::default()
@@ -54,7 +69,7 @@ fn render(quality: Quality, tuning: Tuning) -> (f64, Vec<f64>) {
         ..nominal
     };
     let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
-    voice.pluck(&Pluck::default());
+    voice.pluck(&pluck_at(velocity));
     let blocks = (SECONDS * SAMPLE_RATE) as usize / BLOCK;
     let mut output = Vec::with_capacity(blocks * BLOCK);
     let mut block = [0.0f32; BLOCK];
@@ -95,6 +110,38 @@ fn main() {
                 third_octave_distance_db(&output, &reference, SAMPLE_RATE),
                 deviations.join(" ")
             );
+        }
+    }
+    for velocity in [127, 1] {
+        let pluck = pluck_at(f64::from(velocity) / 127.0);
+        let refined = |refinement| {
+            refined_reference_pluck(
+                &VoiceSettings::default(),
+                refinement,
+                &pluck,
+                SECONDS,
+                SAMPLE_RATE,
+            )
+            .expect("the reference tier is an FD tier")
+            .output
+        };
+        let yardstick = first_partials_hz(&refined(4), SAMPLE_RATE, nominal_hz, PARTIALS);
+        println!("against N = 800 at 16x, linearised tuning, velocity {velocity}");
+        let mut rows = vec![("N = 400, 8x", refined(2))];
+        for quality in Quality::ALL.into_iter().rev() {
+            rows.push((
+                quality.name(),
+                render_at(quality, Tuning::Linearised, f64::from(velocity) / 127.0).1,
+            ));
+        }
+        for (name, output) in rows {
+            let deviations: Vec<String> =
+                first_partials_hz(&output, SAMPLE_RATE, nominal_hz, PARTIALS)
+                    .iter()
+                    .zip(&yardstick)
+                    .map(|(mine, theirs)| format!("{:+.2}", cents(*mine, *theirs)))
+                    .collect();
+            println!("  {name:<11} | {}", deviations.join(" "));
         }
     }
 }

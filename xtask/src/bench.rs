@@ -16,16 +16,14 @@ use crate::args::number_in;
 use crate::playing_range::{self, TierOverGrid};
 use clap::Parser;
 use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz};
+use javari_core::analysis::refined::refined_reference_pluck;
 use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
 use javari_core::newton::NewtonStats;
 use javari_core::tanpura::excitation::Pluck;
-use javari_core::tanpura::fd::decimator::render_decimated;
-use javari_core::tanpura::fd::FdString;
 use javari_core::tanpura::quality::Quality;
-use javari_core::tanpura::tier_string::weighted_pickup_n;
-use javari_core::tanpura::{FirstString, Tanpura, TanpuraVoice, VoiceSettings, TUNING_PASSES};
+use javari_core::tanpura::{FirstString, Tanpura, TanpuraVoice, VoiceSettings};
 use std::error::Error;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -358,41 +356,17 @@ pub struct ReferenceRefinement {
 const REFINEMENT: usize = 4;
 
 /// The one-string scene on the seed's scheme with [`REFINEMENT`] times the reference tier's
-/// intervals and oversampling (its barrier points as they are), configured, tuned (the voice's
-/// passes on its linearised fundamental), plucked and picked up as the reference tier's voice
-/// does, through the tiers' Kaiser decimator, for `seconds`: (intervals, oversampling, output).
+/// intervals and oversampling ([`refined_reference_pluck`]: configured, tuned, plucked and picked
+/// up as the reference tier's voice does), for `seconds`: (intervals, oversampling, output).
 fn refined_one_string(seconds: f64) -> Option<(usize, usize, Vec<f64>)> {
-    let settings = settings_at(Quality::Reference);
-    let tier = Quality::Reference.fd_tier()?;
-    let (intervals, oversample) = (tier.intervals * REFINEMENT, tier.oversample * REFINEMENT);
-    let mut config = settings.fd_config_at(Quality::Reference, SAMPLE_RATE)?;
-    config.intervals = intervals;
-    config.time_step_s = 1.0 / (SAMPLE_RATE * oversample as f64);
-    let mut string = FdString::new(config);
-    // The voice's tuning: passes of T ← T (f / f_lin)² on the linearised fundamental.
-    for _ in 0..TUNING_PASSES {
-        let linearised = string.linearised_fundamental_hz();
-        if !(linearised.is_finite() && linearised > 0.0) {
-            return None;
-        }
-        config.string.tension_n *= (settings.fundamental_hz / linearised).powi(2);
-        string.set_config(config);
-    }
-    string.pluck(&Pluck::default());
-    let samples = (seconds * SAMPLE_RATE) as usize;
-    let output = render_decimated(oversample, samples, || {
-        string.step();
-        weighted_pickup_n(
-            settings.nut_pickup_weight,
-            string.nut_force_n() - string.rest_nut_force_n(),
-            string.bridge_force_n() - string.rest_bridge_force_n(),
-        )
-    })
-    .into_iter()
-    // The voice's output is f32.
-    .map(|sample| f64::from(sample as f32))
-    .collect();
-    Some((intervals, oversample, output))
+    let render = refined_reference_pluck(
+        &settings_at(Quality::Reference),
+        REFINEMENT,
+        &Pluck::default(),
+        seconds,
+        SAMPLE_RATE,
+    )?;
+    Some((render.intervals, render.oversample, render.output))
 }
 
 /// Renders [`refined_one_string`] and measures the one-string scene's tanpura renders in

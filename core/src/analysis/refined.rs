@@ -1,0 +1,71 @@
+//! The reference tier's string on a refined grid: the yardstick against which the bench, the
+//! examples and the tests measure the reference's own discretisation error
+//! (`docs/modal-tanpura.md`, section 9).
+//!
+//! The seed's FD scheme (seed 000, eq. 5–9) with `refinement` times the reference tier's
+//! intervals and oversampling and the barrier's points as they are (finer than any of these
+//! grids), configured, tuned (the voice's [`TUNING_PASSES`] of `T ← T (f / f_lin)²` on the
+//! linearised fundamental), plucked and picked up as the reference tier's voice does, through
+//! the tiers' Kaiser decimator. With `refinement = 1` it is the reference tier's string itself.
+//! Offline only: it allocates, and N = 800 at 16× runs at about a third of real time.
+
+use crate::tanpura::excitation::Pluck;
+use crate::tanpura::fd::decimator::render_decimated;
+use crate::tanpura::fd::FdString;
+use crate::tanpura::quality::Quality;
+use crate::tanpura::tier_string::weighted_pickup_n;
+use crate::tanpura::{VoiceSettings, TUNING_PASSES};
+
+/// A render of [`refined_reference_pluck`]: the grid it ran on and its output at the output rate.
+#[derive(Debug, Clone)]
+pub struct RefinedRender {
+    pub intervals: usize,
+    pub oversample: usize,
+    pub output: Vec<f64>,
+}
+
+/// `pluck` on the string of `settings` (its pitch, losses, bridge, thread and pickup; the tier
+/// is always the reference's, refined `refinement` times), `seconds` long at `sample_rate_hz`.
+/// `None` if the tier has no FD string or the tuning finds no fundamental.
+pub fn refined_reference_pluck(
+    settings: &VoiceSettings,
+    refinement: usize,
+    pluck: &Pluck,
+    seconds: f64,
+    sample_rate_hz: f64,
+) -> Option<RefinedRender> {
+    let tier = Quality::Reference.fd_tier()?;
+    let refinement = refinement.max(1);
+    let (intervals, oversample) = (tier.intervals * refinement, tier.oversample * refinement);
+    let mut config = settings.fd_config_at(Quality::Reference, sample_rate_hz)?;
+    config.intervals = intervals;
+    config.time_step_s = 1.0 / (sample_rate_hz * oversample as f64);
+    let mut string = FdString::new(config);
+    for _ in 0..TUNING_PASSES {
+        let linearised = string.linearised_fundamental_hz();
+        if !(linearised.is_finite() && linearised > 0.0) {
+            return None;
+        }
+        config.string.tension_n *= (settings.fundamental_hz / linearised).powi(2);
+        string.set_config(config);
+    }
+    string.pluck(pluck);
+    let samples = (seconds * sample_rate_hz) as usize;
+    let output = render_decimated(oversample, samples, || {
+        string.step();
+        weighted_pickup_n(
+            settings.nut_pickup_weight,
+            string.nut_force_n() - string.rest_nut_force_n(),
+            string.bridge_force_n() - string.rest_bridge_force_n(),
+        )
+    })
+    .into_iter()
+    // The voice's output is f32.
+    .map(|sample| f64::from(sample as f32))
+    .collect();
+    Some(RefinedRender {
+        intervals,
+        oversample,
+        output,
+    })
+}
