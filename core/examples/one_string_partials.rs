@@ -7,7 +7,7 @@
 //! the fundamental, the third-octave distance to the reference (dB) and the cents of each partial
 //! (`analysis::first_partials_hz`, the bench's measure, 0.5–3 s).
 
-use javari_core::analysis::refined::refined_reference_pluck;
+use javari_core::analysis::refined::{modal_pluck, refined_reference_pluck};
 use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::tanpura::as_played::{as_played_offset_cents, NOTE_VELOCITIES};
 use javari_core::tanpura::excitation::Pluck;
@@ -134,14 +134,31 @@ fn main() {
                 render_at(quality, Tuning::Linearised, f64::from(velocity) / 127.0).1,
             ));
         }
+        let against_yardstick = |output: &[f64], rate: f64| -> String {
+            first_partials_hz(output, rate, nominal_hz, PARTIALS)
+                .iter()
+                .zip(&yardstick)
+                .map(|(mine, theirs)| format!("{:+.2}", cents(*mine, *theirs)))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
         for (name, output) in rows {
-            let deviations: Vec<String> =
-                first_partials_hz(&output, SAMPLE_RATE, nominal_hz, PARTIALS)
-                    .iter()
-                    .zip(&yardstick)
-                    .map(|(mine, theirs)| format!("{:+.2}", cents(*mine, *theirs)))
-                    .collect();
-            println!("  {name:<11} | {}", deviations.join(" "));
+            println!("  {name:<11} | {}", against_yardstick(&output, SAMPLE_RATE));
+        }
+        let live = VoiceSettings {
+            quality: Quality::Live,
+            ..VoiceSettings::default()
+        };
+        for residual_modes in [0, 2] {
+            for rate_factor in [1.0, 2.0, 4.0] {
+                let rate = SAMPLE_RATE * rate_factor;
+                let output = modal_pluck(&live, rate, residual_modes, &pluck, SECONDS)
+                    .expect("the live tier is modal");
+                println!(
+                    "  live, {residual_modes} residual modes, {rate_factor}x rate | {}",
+                    against_yardstick(&output, rate)
+                );
+            }
         }
     }
 }

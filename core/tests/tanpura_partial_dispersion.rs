@@ -11,7 +11,7 @@
 //! one-cent target the issues set the tiers against the reference is below the reference's own
 //! dispersion at the tenth partial.
 
-use javari_core::analysis::refined::refined_reference_pluck;
+use javari_core::analysis::refined::{modal_pluck, refined_reference_pluck};
 use javari_core::analysis::{cents, first_partials_hz};
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
@@ -94,5 +94,22 @@ fn modal_partials_are_the_continuous_strings_and_the_reference_grids_fall_flat()
     let voice = tier_partials(Quality::Reference);
     for (voice, coarse) in voice.iter().zip(&coarse) {
         assert!(cents(*voice, *coarse).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn the_offline_modal_string_is_the_voices() {
+    let settings = VoiceSettings {
+        quality: Quality::Live,
+        ..VoiceSettings::default()
+    };
+    let seconds = 0.2;
+    let offline = modal_pluck(&settings, OUTPUT_RATE_HZ, 0, &Pluck::default(), seconds)
+        .expect("the live tier is modal");
+    let mut voice = TanpuraVoice::new(&settings, OUTPUT_RATE_HZ);
+    voice.pluck(&Pluck::default());
+    assert_eq!(offline.len(), (seconds * OUTPUT_RATE_HZ) as usize);
+    for (index, sample) in offline.iter().enumerate() {
+        assert_eq!(*sample, f64::from(voice.next_sample()), "sample {index}");
     }
 }

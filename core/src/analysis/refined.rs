@@ -1,6 +1,8 @@
-//! The reference tier's string on a refined grid: the yardstick against which the bench, the
-//! examples and the tests measure the reference's own discretisation error
-//! (`docs/modal-tanpura.md`, section 9).
+//! One string rendered outside the tiers' configurations, for the offline comparisons of
+//! `docs/modal-tanpura.md`, section 9: the reference tier's string on a refined grid (the
+//! yardstick against which the bench, the examples and the tests measure the reference's own
+//! discretisation error), and a modal tier's string at another sample rate or with residual
+//! modes (section 8).
 //!
 //! The seed's FD scheme (seed 000, eq. 5–9) with `refinement` times the reference tier's
 //! intervals and oversampling and the barrier's points as they are (finer than any of these
@@ -8,10 +10,15 @@
 //! linearised fundamental), plucked and picked up as the reference tier's voice does, through
 //! the tiers' Kaiser decimator. With `refinement = 1` it is the reference tier's string itself.
 //! Offline only: it allocates, and N = 800 at 16× runs at about a third of real time.
+//!
+//! [`modal_pluck`] builds a modal tier's string as the voice builds it (`VoiceSettings::
+//! modal_config_at`, f32 modes), tunes it by the same passes, plucks it and picks it up as the
+//! voice does; with the voice's sample rate and no residual modes it is the voice's output.
 
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::fd::decimator::render_decimated;
 use crate::tanpura::fd::FdString;
+use crate::tanpura::modal::ModalString;
 use crate::tanpura::quality::Quality;
 use crate::tanpura::tier_string::weighted_pickup_n;
 use crate::tanpura::{VoiceSettings, TUNING_PASSES};
@@ -68,4 +75,43 @@ pub fn refined_reference_pluck(
         oversample,
         output,
     })
+}
+
+/// `pluck` on the modal string of `settings` (whose tier must be modal) at `sample_rate_hz`
+/// with `residual_modes` residual modes, `seconds` long at that rate. `None` if the tier is not
+/// modal or the tuning finds no fundamental.
+pub fn modal_pluck(
+    settings: &VoiceSettings,
+    sample_rate_hz: f64,
+    residual_modes: usize,
+    pluck: &Pluck,
+    seconds: f64,
+) -> Option<Vec<f64>> {
+    let mut config = settings.modal_config_at(settings.quality, sample_rate_hz)?;
+    config.residual_modes = residual_modes;
+    let mut string = ModalString::<f32>::new(config);
+    for _ in 0..TUNING_PASSES {
+        let linearised = string.linearised_fundamental_hz();
+        if !(linearised.is_finite() && linearised > 0.0) {
+            return None;
+        }
+        config.string.tension_n *= (settings.fundamental_hz / linearised).powi(2);
+        string.set_config(config);
+    }
+    string.pluck(pluck);
+    let samples = (seconds * sample_rate_hz) as usize;
+    Some(
+        (0..samples)
+            .map(|_| {
+                string.step();
+                let pickup = weighted_pickup_n(
+                    settings.nut_pickup_weight,
+                    string.nut_force_change_n(),
+                    string.bridge_force_change_n(),
+                );
+                // The voice's output is f32.
+                f64::from(pickup as f32)
+            })
+            .collect(),
+    )
 }
