@@ -23,6 +23,25 @@ use crate::tanpura::quality::Quality;
 use crate::tanpura::tier_string::weighted_pickup_n;
 use crate::tanpura::{VoiceSettings, TUNING_PASSES};
 
+/// The voice's tuning: [`TUNING_PASSES`] of `T ← T (f / f_lin)²` on `string`, whose
+/// linearised fundamental `linearised_hz` gives and whose tension `scale_tension` multiplies by
+/// the factor it is given. `None` if no fundamental is found.
+fn tune<S>(
+    string: &mut S,
+    target_hz: f64,
+    linearised_hz: impl Fn(&mut S) -> f64,
+    mut scale_tension: impl FnMut(&mut S, f64),
+) -> Option<()> {
+    for _ in 0..TUNING_PASSES {
+        let linearised = linearised_hz(string);
+        if !(linearised.is_finite() && linearised > 0.0) {
+            return None;
+        }
+        scale_tension(string, (target_hz / linearised).powi(2));
+    }
+    Some(())
+}
+
 /// A render of [`refined_reference_pluck`]: the grid it ran on and its output at the output rate.
 #[derive(Debug, Clone)]
 pub struct RefinedRender {
@@ -48,14 +67,15 @@ pub fn refined_reference_pluck(
     config.intervals = intervals;
     config.time_step_s = 1.0 / (sample_rate_hz * oversample as f64);
     let mut string = FdString::new(config);
-    for _ in 0..TUNING_PASSES {
-        let linearised = string.linearised_fundamental_hz();
-        if !(linearised.is_finite() && linearised > 0.0) {
-            return None;
-        }
-        config.string.tension_n *= (settings.fundamental_hz / linearised).powi(2);
-        string.set_config(config);
-    }
+    tune(
+        &mut string,
+        settings.fundamental_hz,
+        FdString::linearised_fundamental_hz,
+        |string, factor| {
+            config.string.tension_n *= factor;
+            string.set_config(config);
+        },
+    )?;
     string.pluck(pluck);
     let samples = (seconds * sample_rate_hz) as usize;
     let output = render_decimated(oversample, samples, || {
@@ -90,14 +110,15 @@ pub fn modal_pluck(
     let mut config = settings.modal_config_at(settings.quality, sample_rate_hz)?;
     config.residual_modes = residual_modes;
     let mut string = ModalString::<f32>::new(config);
-    for _ in 0..TUNING_PASSES {
-        let linearised = string.linearised_fundamental_hz();
-        if !(linearised.is_finite() && linearised > 0.0) {
-            return None;
-        }
-        config.string.tension_n *= (settings.fundamental_hz / linearised).powi(2);
-        string.set_config(config);
-    }
+    tune(
+        &mut string,
+        settings.fundamental_hz,
+        ModalString::linearised_fundamental_hz,
+        |string, factor| {
+            config.string.tension_n *= factor;
+            string.set_config(config);
+        },
+    )?;
     string.pluck(pluck);
     let samples = (seconds * sample_rate_hz) as usize;
     Some(
