@@ -9,7 +9,8 @@
 //! grids), configured, tuned (the voice's [`TUNING_PASSES`] of `T ← T (f / f_lin)²` on the
 //! linearised fundamental), plucked and picked up as the reference tier's voice does, through
 //! the tiers' Kaiser decimator. With `refinement = 1` it is the reference tier's string itself.
-//! Offline only: it allocates, and N = 800 at 16× runs at about a third of real time.
+//! Offline only: it allocates, and N = 800 at 16× does 16 times the reference tier's work per
+//! second of sound (slower than real time).
 //!
 //! [`modal_pluck`] builds a modal tier's string as the voice builds it (`VoiceSettings::
 //! modal_config_at`, f32 modes), tunes it by the same passes, plucks it and picks it up as the
