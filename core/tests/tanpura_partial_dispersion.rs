@@ -10,6 +10,9 @@
 //! the tenth), while the reference's tenth lies more than two cents flat (measured: 2.7): the
 //! one-cent target the issues set the tiers against the reference is below the reference's own
 //! dispersion at the tenth partial.
+//!
+//! The yardsticks are `analysis::refined`'s offline strings: its unrefined FD string gives the
+//! reference tier's partials, and its modal string is the live voice's output bit for bit.
 
 use javari_core::analysis::refined::{modal_pluck, refined_reference_pluck};
 use javari_core::analysis::{cents, first_partials_hz};
