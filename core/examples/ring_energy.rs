@@ -12,16 +12,22 @@ use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
 const OUTPUT_RATE_HZ: f64 = 44_100.0;
 const TIMES_S: [f64; 5] = [0.0, 0.1, 0.25, 0.5, 1.0];
 
-/// The energies at [`TIMES_S`] of a string stepped `steps_per_second` times per second.
-fn energies(steps_per_second: f64, mut step: impl FnMut(), energy: impl Fn() -> f64) -> String {
+/// The vibration energies at [`TIMES_S`] of `string`, stepped `steps_per_second` times per
+/// second by `step`, as `energy` reads them.
+fn energies<S>(
+    string: &mut S,
+    steps_per_second: f64,
+    step: impl Fn(&mut S),
+    energy: impl Fn(&S) -> f64,
+) -> String {
     let mut done = 0usize;
     let mut row = Vec::new();
     for seconds in TIMES_S {
         while (done as f64) < seconds * steps_per_second {
-            step();
+            step(string);
             done += 1;
         }
-        row.push(format!("{:.3e}", energy()));
+        row.push(format!("{:.3e}", energy(string)));
     }
     row.join("  ")
 }
@@ -29,29 +35,31 @@ fn energies(steps_per_second: f64, mut step: impl FnMut(), energy: impl Fn() -> 
 fn main() {
     println!("seconds after the pluck: {TIMES_S:?}");
     for (intervals, oversampling) in [(200, 4), (400, 8), (800, 16)] {
-        let string = std::cell::RefCell::new(FdString::new(FdStringConfig {
+        let mut string = FdString::new(FdStringConfig {
             intervals,
             time_step_s: 1.0 / (OUTPUT_RATE_HZ * oversampling as f64),
             ..FdStringConfig::REFERENCE
-        }));
-        string.borrow_mut().pluck(&Pluck::default());
+        });
+        string.pluck(&Pluck::default());
         let row = energies(
+            &mut string,
             OUTPUT_RATE_HZ * oversampling as f64,
-            || string.borrow_mut().step(),
-            || string.borrow().vibration_energy_j(),
+            FdString::step,
+            FdString::vibration_energy_j,
         );
         println!("FD N = {intervals} at {oversampling}x: {row}");
     }
     for (name, static_flexibility) in [("kept modes only", false), ("static flexibility", true)] {
-        let string = std::cell::RefCell::new(ModalString::<f64>::new(ModalStringConfig {
+        let mut string = ModalString::<f64>::new(ModalStringConfig {
             static_flexibility,
             ..ModalStringConfig::REFERENCE
-        }));
-        string.borrow_mut().pluck(&Pluck::default());
+        });
+        string.pluck(&Pluck::default());
         let row = energies(
+            &mut string,
             OUTPUT_RATE_HZ,
-            || string.borrow_mut().step(),
-            || string.borrow().vibration_energy_j(),
+            ModalString::step,
+            ModalString::vibration_energy_j,
         );
         println!("modal, {name}: {row}");
     }

@@ -16,7 +16,7 @@ use crate::args::number_in;
 use crate::playing_range::{self, TierOverGrid};
 use clap::Parser;
 use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz};
-use javari_core::analysis::refined::refined_reference_pluck;
+use javari_core::analysis::refined::{refined_reference_pluck, RefinedRender};
 use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
@@ -357,16 +357,15 @@ const REFINEMENT: usize = 4;
 
 /// The one-string scene on the seed's scheme with [`REFINEMENT`] times the reference tier's
 /// intervals and oversampling ([`refined_reference_pluck`]: configured, tuned, plucked and picked
-/// up as the reference tier's voice does), for `seconds`: (intervals, oversampling, output).
-fn refined_one_string(seconds: f64) -> Option<(usize, usize, Vec<f64>)> {
-    let render = refined_reference_pluck(
+/// up as the reference tier's voice does), for `seconds`.
+fn refined_one_string(seconds: f64) -> Option<RefinedRender> {
+    refined_reference_pluck(
         &settings_at(Quality::Reference),
         REFINEMENT,
         &Pluck::default(),
         seconds,
         SAMPLE_RATE,
-    )?;
-    Some((render.intervals, render.oversample, render.output))
+    )
 }
 
 /// Renders [`refined_one_string`] and measures the one-string scene's tanpura renders in
@@ -383,13 +382,17 @@ pub fn run_reference_refinement(
         return None;
     }
     eprintln!("bench: one-string, against a reference grid {REFINEMENT} times finer ...");
-    let (intervals, oversample, refined) = refined_one_string(seconds)?;
+    let refined = refined_one_string(seconds)?;
     let fundamental = settings_at(Quality::Reference).fundamental_hz;
     let tiers = one_string
         .iter()
         .map(|result| {
-            let (cents_error_max, spectral_distance_db, formant_error) =
-                errors_against(&result.output, result.fundamental_hz, &refined, fundamental);
+            let (cents_error_max, spectral_distance_db, formant_error) = errors_against(
+                &result.output,
+                result.fundamental_hz,
+                &refined.output,
+                fundamental,
+            );
             AgainstRefinement {
                 tier: result.tier,
                 cents_error_max,
@@ -399,8 +402,8 @@ pub fn run_reference_refinement(
         })
         .collect();
     Some(ReferenceRefinement {
-        intervals,
-        oversample,
+        intervals: refined.intervals,
+        oversample: refined.oversample,
         tiers,
     })
 }

@@ -24,21 +24,24 @@ use crate::tanpura::quality::Quality;
 use crate::tanpura::tier_string::weighted_pickup_n;
 use crate::tanpura::{VoiceSettings, TUNING_PASSES};
 
-/// The voice's tuning: [`TUNING_PASSES`] of `T ← T (f / f_lin)²` on `string`, whose
-/// linearised fundamental `linearised_hz` gives and whose tension `scale_tension` multiplies by
-/// the factor it is given. `None` if no fundamental is found.
+/// The voice's tuning (`TanpuraVoice::configure_string`, the same arithmetic): [`TUNING_PASSES`]
+/// of `T ← T (f / f_lin)²` on `string`, whose linearised fundamental `linearised_hz` gives, whose
+/// tension `tension_n` reads and `set_tension` sets. `None` if no fundamental is found.
 fn tune<S>(
     string: &mut S,
     target_hz: f64,
     linearised_hz: impl Fn(&mut S) -> f64,
-    mut scale_tension: impl FnMut(&mut S, f64),
+    tension_n: impl Fn(&S) -> f64,
+    mut set_tension: impl FnMut(&mut S, f64),
 ) -> Option<()> {
     for _ in 0..TUNING_PASSES {
         let linearised = linearised_hz(string);
         if !(linearised.is_finite() && linearised > 0.0) {
             return None;
         }
-        scale_tension(string, (target_hz / linearised).powi(2));
+        let ratio = target_hz / linearised;
+        let tension = tension_n(string) * ratio * ratio;
+        set_tension(string, tension);
     }
     Some(())
 }
@@ -72,8 +75,9 @@ pub fn refined_reference_pluck(
         &mut string,
         settings.fundamental_hz,
         FdString::linearised_fundamental_hz,
-        |string, factor| {
-            config.string.tension_n *= factor;
+        |string| string.config().string.tension_n,
+        |string, tension| {
+            config.string.tension_n = tension;
             string.set_config(config);
         },
     )?;
@@ -115,8 +119,9 @@ pub fn modal_pluck(
         &mut string,
         settings.fundamental_hz,
         ModalString::linearised_fundamental_hz,
-        |string, factor| {
-            config.string.tension_n *= factor;
+        |string| string.config().string.tension_n,
+        |string, tension| {
+            config.string.tension_n = tension;
             string.set_config(config);
         },
     )?;
