@@ -3,13 +3,20 @@
 //! the bench's scene uses (`TanpuraVoice::new`), the as-played tuning the plugin and `render`
 //! use by default (velocities 40 and 110 centred, `tanpura/as_played.rs`), and the as-played
 //! tuning at the scene's own pluck (velocity 127). `cargo run --release -p javari-core --example
-//! one_string_partials` (about 30 s). Prints, per tuning and tier, the calibration offset,
-//! the fundamental, the third-octave distance to the reference (dB) and the cents of each partial
-//! (`analysis::first_partials_hz`, the bench's measure, 0.5–3 s).
+//! one_string_partials` (about a minute). Prints first each tier's sustained pitch (0.3–1.5 s)
+//! as the pluck's velocity grows (linearised tuning); then, per tuning and tier, the calibration
+//! offset, the fundamental, the third-octave distance to the reference (dB) and the cents of each
+//! partial (`analysis::first_partials_hz`, the bench's measure, 0.5–3 s); then, with the
+//! linearised tuning, every tier's partials and the seed's scheme's at N = 400 (8×) against
+//! N = 800 (16×, `analysis::refined`), at the scene's pluck (velocity 127) and barely plucked
+//! (velocity 1), with the live tier's string with two residual modes (`docs/modal-tanpura.md`,
+//! section 8) at the output rate and at two and four times it.
 
 use javari_core::analysis::refined::{modal_pluck, refined_reference_pluck};
 use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
-use javari_core::tanpura::as_played::{as_played_offset_cents, NOTE_VELOCITIES};
+use javari_core::tanpura::as_played::{
+    as_played_offset_cents, sustained_pitch_of_pluck_hz, NOTE_VELOCITIES,
+};
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
@@ -82,6 +89,29 @@ fn render_at(quality: Quality, tuning: Tuning, velocity: f64) -> (f64, Vec<f64>)
 
 fn main() {
     let nominal_hz = VoiceSettings::default().fundamental_hz;
+    println!("sustained pitch (0.3-1.5 s), linearised tuning, cents from the note, velocities 1 40 80 110 127");
+    for quality in Quality::ALL.into_iter().rev() {
+        let settings = VoiceSettings {
+            quality,
+            ..VoiceSettings::default()
+        };
+        let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
+        let row: Vec<String> = [1.0, 40.0, 80.0, 110.0, 127.0]
+            .iter()
+            .map(|velocity| {
+                let pitch = sustained_pitch_of_pluck_hz(
+                    &mut voice,
+                    nominal_hz,
+                    nominal_hz,
+                    &Pluck::default(),
+                    velocity / 127.0,
+                    SAMPLE_RATE,
+                );
+                format!("{:+.2}", cents(pitch, nominal_hz))
+            })
+            .collect();
+        println!("  {:<9} | {}", quality.name(), row.join(" "));
+    }
     for tuning in [
         Tuning::Linearised,
         Tuning::AsPlayed(NOTE_VELOCITIES),
