@@ -19,6 +19,7 @@ use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz
 use javari_core::analysis::refined::{refined_reference_pluck, RefinedRender};
 use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
+use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
 use javari_core::newton::NewtonStats;
 use javari_core::tanpura::excitation::Pluck;
@@ -528,6 +529,100 @@ pub fn run_all(seconds: f64, runs: u32) -> Vec<BenchResult> {
     results
 }
 
+/// One tier's one-string scene at every key of the instrument's range: the real-time factor
+/// (fastest of the bench's runs) per key.
+#[derive(Debug, Clone)]
+pub struct KeySpeeds {
+    pub tier: &'static str,
+    pub factors: Vec<(u8, f64)>,
+}
+
+impl KeySpeeds {
+    /// The slowest key and its factor.
+    pub fn slowest(&self) -> Option<(u8, f64)> {
+        self.factors
+            .iter()
+            .copied()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    pub fn median_factor(&self) -> f64 {
+        let mut factors: Vec<f64> = self.factors.iter().map(|&(_, factor)| factor).collect();
+        factors.sort_by(f64::total_cmp);
+        percentile(&factors, 0.5)
+    }
+}
+
+/// The instrument's range for the speed across keys: every key of the playing-range grid's span.
+pub const SPEED_KEYS: std::ops::RangeInclusive<u8> = 36..=64;
+
+/// The one-string scene (the default pluck, linearised tuning) with the string at every key of
+/// [`SPEED_KEYS`], on every tier: what one string costs is a worst case over the range, since
+/// the string's modes and the points it rests on change with its tension.
+pub fn run_key_speeds(seconds: f64, runs: u32) -> Vec<KeySpeeds> {
+    Quality::ALL
+        .iter()
+        .map(|&quality| {
+            let factors = SPEED_KEYS
+                .map(|key| {
+                    let settings = VoiceSettings {
+                        fundamental_hz: note_to_hz(key),
+                        ..settings_at(quality)
+                    };
+                    let label = Label {
+                        voice: "tanpura",
+                        tier: quality.name(),
+                        scene: "one-string",
+                        fundamental_hz: settings.fundamental_hz,
+                    };
+                    let build = || -> Box<dyn Scene> {
+                        Box::new(OneString {
+                            voice: TanpuraVoice::new(&settings, SAMPLE_RATE),
+                        })
+                    };
+                    (
+                        key,
+                        measure_best(runs, build, seconds, label).realtime_factor,
+                    )
+                })
+                .collect();
+            KeySpeeds {
+                tier: quality.name(),
+                factors,
+            }
+        })
+        .collect()
+}
+
+pub fn key_speeds_markdown(rows: &[KeySpeeds]) -> String {
+    let mut text = format!(
+        "
+One string at every key {}–{} (the one-string scene's pluck at each key's pitch; the          fastest of the runs per key):
+
+         | tier | slowest key | median over the keys | fastest key |
+|---|---|---|---|
+",
+        SPEED_KEYS.start(),
+        SPEED_KEYS.end()
+    );
+    for row in rows {
+        let fastest = row
+            .factors
+            .iter()
+            .copied()
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if let (Some((slow_key, slow)), Some((fast_key, fast))) = (row.slowest(), fastest) {
+            let _ = writeln!(
+                text,
+                "| {} | {slow:.2}× (key {slow_key}) | {:.2}× | {fast:.2}× (key {fast_key}) |",
+                row.tier,
+                row.median_factor()
+            );
+        }
+    }
+    text
+}
+
 /// What the engine saves by simulating only what a scene needs, on the live tier.
 #[derive(Debug, Clone)]
 pub struct EconomyRow {
@@ -647,7 +742,11 @@ impl Scene for OneOfFour {
 }
 
 /// The issue's targets, each checked against the measured results: met, or missed by how much.
-pub fn targets_markdown(results: &[BenchResult], grid: &[TierOverGrid]) -> String {
+pub fn targets_markdown(
+    results: &[BenchResult],
+    keys: &[KeySpeeds],
+    grid: &[TierOverGrid],
+) -> String {
     let find = |voice: &str, tier: &str, scene: &str| {
         results
             .iter()
@@ -676,9 +775,26 @@ pub fn targets_markdown(results: &[BenchResult], grid: &[TierOverGrid]) -> Strin
         let _ = writeln!(text, "| {target} | {shown} | {verdict} |");
     };
     let tanpura = |tier: &str, scene: &str| find("tanpura", tier, scene);
+    let slowest_key = |tier: &str| {
+        keys.iter()
+            .find(|row| row.tier == tier)
+            .and_then(KeySpeeds::slowest)
+    };
     line(
         "live tier (modal), one string: ≥ 100× real time",
         tanpura("live", "one-string").map(|r| r.realtime_factor),
+        100.0,
+        true,
+        "×",
+    );
+    line(
+        &format!(
+            "live tier, one string at its slowest key of {}–{}{}: ≥ 100× real time",
+            SPEED_KEYS.start(),
+            SPEED_KEYS.end(),
+            slowest_key("live").map_or(String::new(), |(key, _)| format!(" (key {key})"))
+        ),
+        slowest_key("live").map(|(_, factor)| factor),
         100.0,
         true,
         "×",
@@ -724,6 +840,16 @@ pub fn targets_markdown(results: &[BenchResult], grid: &[TierOverGrid]) -> Strin
     line(
         "reference tier, one string: ≥ 4× real time",
         tanpura("reference", "one-string").map(|r| r.realtime_factor),
+        4.0,
+        true,
+        "×",
+    );
+    line(
+        &format!(
+            "reference tier, one string at its slowest key{}: ≥ 4× real time",
+            slowest_key("reference").map_or(String::new(), |(key, _)| format!(" (key {key})"))
+        ),
+        slowest_key("reference").map(|(_, factor)| factor),
         4.0,
         true,
         "×",
@@ -798,6 +924,7 @@ pub fn to_json(
     machine: &str,
     results: &[BenchResult],
     economy: &[EconomyRow],
+    keys: &[KeySpeeds],
     grid: &[TierOverGrid],
     refinement: Option<&ReferenceRefinement>,
 ) -> String {
@@ -835,6 +962,18 @@ pub fn to_json(
             )
         })
         .collect();
+    let key_rows: Vec<String> = keys
+        .iter()
+        .flat_map(|row| {
+            row.factors.iter().map(|&(key, factor)| {
+                format!(
+                    "{{\"tier\": \"{}\", \"key\": {key}, \"realtime_factor\": {}}}",
+                    row.tier,
+                    json_number(Some(factor))
+                )
+            })
+        })
+        .collect();
     let refinement = refinement.map_or("null".to_string(), |r| {
         let tiers: Vec<String> = r
             .tiers
@@ -859,10 +998,12 @@ pub fn to_json(
     });
     format!(
         "{{\"machine\": \"{}\", \"results\": [\n  {}\n], \"economy\": [\n  {}\n], \
-         \"playing_range\": [\n  {}\n], \"reference_refinement\": {}}}\n",
+         \"speed_across_keys\": [\n  {}\n], \"playing_range\": [\n  {}\n], \
+         \"reference_refinement\": {}}}\n",
         machine.replace('"', "'"),
         rows.join(",\n  "),
         economy_rows.join(",\n  "),
+        key_rows.join(",\n  "),
         playing_range::to_json_rows(grid).join(",\n  "),
         refinement
     )
@@ -933,10 +1074,14 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
         }
     }
     // The timing scenes run first, alone: the grid renders on every core.
-    let (results, economy) = if grid_only {
-        (Vec::new(), Vec::new())
+    let (results, economy, keys) = if grid_only {
+        (Vec::new(), Vec::new(), Vec::new())
     } else {
-        (run_all(seconds, runs), run_economy(seconds, runs))
+        (
+            run_all(seconds, runs),
+            run_economy(seconds, runs),
+            run_key_speeds(seconds, runs),
+        )
     };
     let refinement = run_reference_refinement(&results, seconds);
     let grid = if no_grid {
@@ -956,7 +1101,10 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     if !grid.is_empty() {
         table += &playing_range::to_markdown(&grid);
     }
-    table += &targets_markdown(&results, &grid);
+    if !keys.is_empty() {
+        table += &key_speeds_markdown(&keys);
+    }
+    table += &targets_markdown(&results, &keys, &grid);
     if let Some(refinement) = &refinement {
         table += &refinement_markdown(refinement);
     }
@@ -969,7 +1117,14 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     if let Some(path) = json {
         std::fs::write(
             &path,
-            to_json(&machine, &results, &economy, &grid, refinement.as_ref()),
+            to_json(
+                &machine,
+                &results,
+                &economy,
+                &keys,
+                &grid,
+                refinement.as_ref(),
+            ),
         )
         .map_err(|error| format!("cannot write `{}`: {error}", path.display()))?;
     }
@@ -979,6 +1134,25 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_speed_target_across_keys_reads_the_slowest_key() {
+        let live = KeySpeeds {
+            tier: "live",
+            factors: vec![(36, 150.0), (60, 88.0), (64, 104.0)],
+        };
+        assert_eq!(live.slowest(), Some((60, 88.0)));
+        assert_eq!(live.median_factor(), 104.0);
+        let targets = targets_markdown(&[], std::slice::from_ref(&live), &[]);
+        assert!(targets.contains(
+            "| live tier, one string at its slowest key of 36–64 (key 60): ≥ 100× real time \
+             | 88.00× | missed: 1.1× short |"
+        ));
+        let table = key_speeds_markdown(std::slice::from_ref(&live));
+        assert!(table.contains("| live | 88.00× (key 60) | 104.00× | 150.00× (key 36) |"));
+        let json = to_json("machine", &[], &[], &[live], &[], None);
+        assert!(json.contains("{\"tier\": \"live\", \"key\": 60, \"realtime_factor\": 88.000000}"));
+    }
 
     #[test]
     fn the_refined_reference_is_a_finer_grid_of_the_same_string() {
@@ -1007,7 +1181,7 @@ mod tests {
             "{}",
             row.spectral_distance_db
         );
-        let json = to_json("machine", &[], &[], &[], Some(&refinement));
+        let json = to_json("machine", &[], &[], &[], &[], Some(&refinement));
         assert!(json.contains(
             "\"reference_refinement\": {\"intervals\": 800, \"oversample\": 16, \"tiers\": \
              [{\"tier\": \"reference\""
