@@ -596,12 +596,9 @@ pub fn run_key_speeds(seconds: f64, runs: u32) -> Vec<KeySpeeds> {
 
 pub fn key_speeds_markdown(rows: &[KeySpeeds]) -> String {
     let mut text = format!(
-        "
-One string at every key {}–{} (the one-string scene's pluck at each key's pitch; the          fastest of the runs per key):
-
-         | tier | slowest key | median over the keys | fastest key |
-|---|---|---|---|
-",
+        "\nOne string at every key {}–{} (the one-string scene's pluck at each key's pitch; the \
+         fastest of the runs per key):\n\n\
+         | tier | slowest key | median over the keys | fastest key |\n|---|---|---|---|\n",
         SPEED_KEYS.start(),
         SPEED_KEYS.end()
     );
@@ -741,6 +738,15 @@ impl Scene for OneOfFour {
     }
 }
 
+/// How far a target is missed: one decimal, two below 1.1 (where one would read "1.0").
+fn ratio_text(ratio: f64) -> String {
+    if ratio < 1.1 {
+        format!("{ratio:.2}")
+    } else {
+        format!("{ratio:.1}")
+    }
+}
+
 /// The issue's targets, each checked against the measured results: met, or missed by how much.
 pub fn targets_markdown(
     results: &[BenchResult],
@@ -765,9 +771,9 @@ pub fn targets_markdown(
                 let verdict = if met {
                     "met".to_string()
                 } else if at_least {
-                    format!("missed: {:.1}× short", goal / value)
+                    format!("missed: {}× short", ratio_text(goal / value))
                 } else {
-                    format!("missed: {:.1}× over", value / goal)
+                    format!("missed: {}× over", ratio_text(value / goal))
                 };
                 (format!("{value:.2}{unit}"), verdict)
             }
