@@ -9,6 +9,10 @@
 //! centroid above 5.5 f₀ across the analysis windows). The contact dynamics amplify round-off,
 //! so outputs of different tiers are compared as spectra, never sample by sample.
 //!
+//! Speed is a worst case over the instrument's range: the one-string scene is also timed with
+//! the string at every key 36–64 on every tier, and the one-string targets are read at the
+//! slowest key as well as at the scene's own.
+//!
 //! Writes a markdown table (`--markdown FILE`, default `bench.md`) and, with `--json FILE`, one
 //! JSON object. A benchmark, not a test: nothing here asserts on time.
 
