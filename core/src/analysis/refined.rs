@@ -6,8 +6,8 @@
 //!
 //! The seed's FD scheme (seed 000, eq. 5–9) with `refinement` times the reference tier's
 //! intervals and oversampling and the barrier's points as they are (finer than any of these
-//! grids), configured, tuned (the voice's [`TUNING_PASSES`] of `T ← T (f / f_lin)²` on the
-//! linearised fundamental), plucked and picked up as the reference tier's voice does, through
+//! grids), configured, tuned by the voice's own [`tune_tension`] (passes of
+//! `T ← T (f / f_lin)²` on the linearised fundamental), plucked and picked up as the reference tier's voice does, through
 //! the tiers' Kaiser decimator. With `refinement = 1` it is the reference tier's string itself.
 //! Offline only: it allocates, and N = 800 at 16× does 16 times the reference tier's work per
 //! second of sound (slower than real time).
@@ -22,29 +22,8 @@ use crate::tanpura::fd::FdString;
 use crate::tanpura::modal::ModalString;
 use crate::tanpura::quality::Quality;
 use crate::tanpura::tier_string::weighted_pickup_n;
-use crate::tanpura::{VoiceSettings, TUNING_PASSES};
-
-/// The voice's tuning (`TanpuraVoice::configure_string`, the same arithmetic): [`TUNING_PASSES`]
-/// of `T ← T (f / f_lin)²` on `string`, whose linearised fundamental `linearised_hz` gives, whose
-/// tension `tension_n` reads and `set_tension` sets. `None` if no fundamental is found.
-fn tune<S>(
-    string: &mut S,
-    target_hz: f64,
-    linearised_hz: impl Fn(&mut S) -> f64,
-    tension_n: impl Fn(&S) -> f64,
-    mut set_tension: impl FnMut(&mut S, f64),
-) -> Option<()> {
-    for _ in 0..TUNING_PASSES {
-        let linearised = linearised_hz(string);
-        if !(linearised.is_finite() && linearised > 0.0) {
-            return None;
-        }
-        let ratio = target_hz / linearised;
-        let tension = tension_n(string) * ratio * ratio;
-        set_tension(string, tension);
-    }
-    Some(())
-}
+use crate::tanpura::voice::tune_tension;
+use crate::tanpura::VoiceSettings;
 
 /// A render of [`refined_reference_pluck`]: the grid it ran on and its output at the output rate.
 #[derive(Debug, Clone)]
@@ -71,7 +50,7 @@ pub fn refined_reference_pluck(
     config.intervals = intervals;
     config.time_step_s = 1.0 / (sample_rate_hz * oversample as f64);
     let mut string = FdString::new(config);
-    tune(
+    tune_tension(
         &mut string,
         settings.fundamental_hz,
         FdString::linearised_fundamental_hz,
@@ -115,7 +94,7 @@ pub fn modal_pluck(
     let mut config = settings.modal_config_at(settings.quality, sample_rate_hz)?;
     config.residual_modes = residual_modes;
     let mut string = ModalString::<f32>::new(config);
-    tune(
+    tune_tension(
         &mut string,
         settings.fundamental_hz,
         ModalString::linearised_fundamental_hz,

@@ -37,6 +37,30 @@ const SLEEP_CHECK_INTERVAL: u32 = 256;
 /// Passes of the tension correction `T ← T (f / f_lin)²` that tunes a string by its linearised
 /// fundamental (see `TanpuraVoice::configure_string`).
 pub const TUNING_PASSES: usize = 2;
+
+/// The tuning of every tier's string: [`TUNING_PASSES`] of `T ← T (f / f_lin)²` on `string`,
+/// whose linearised fundamental `linearised_hz` gives, whose tension `tension_n` reads and
+/// `set_tension` sets, towards `target_hz`. Stops (returning `None`) when no fundamental is
+/// found. The voice tunes its strings with it, and `analysis::refined` tunes the offline
+/// strings with it, so the two agree bit for bit. Allocation-free.
+pub fn tune_tension<S>(
+    string: &mut S,
+    target_hz: f64,
+    mut linearised_hz: impl FnMut(&mut S) -> f64,
+    tension_n: impl Fn(&S) -> f64,
+    mut set_tension: impl FnMut(&mut S, f64),
+) -> Option<()> {
+    for _ in 0..TUNING_PASSES {
+        let linearised = linearised_hz(string);
+        if !(linearised.is_finite() && linearised > 0.0) {
+            return None;
+        }
+        let ratio = target_hz / linearised;
+        let tension = tension_n(string) * ratio * ratio;
+        set_tension(string, tension);
+    }
+    Some(())
+}
 /// Largest internal oversampling factor.
 pub const MAX_OVERSAMPLE: usize = 8;
 
@@ -462,16 +486,14 @@ impl TanpuraVoice {
             }
         }
         self.apply_config(None);
-        for _ in 0..TUNING_PASSES {
-            let string = &mut self.strings[index];
-            let linearised = string.linearised_fundamental_hz();
-            if !(linearised.is_finite() && linearised > 0.0) {
-                break;
-            }
-            let ratio = settings.fundamental_hz / linearised;
-            let tension = string.parameters().tension_n * ratio * ratio;
-            self.apply_config(Some(tension));
-        }
+        // A string with no fundamental keeps the tension reached so far.
+        let _ = tune_tension(
+            self,
+            settings.fundamental_hz,
+            |voice| voice.strings[index].linearised_fundamental_hz(),
+            |voice| voice.strings[index].parameters().tension_n,
+            |voice, tension| voice.apply_config(Some(tension)),
+        );
         self.configured[index] = Some(settings);
     }
 
