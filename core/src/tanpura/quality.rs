@@ -9,7 +9,7 @@
 //!   millimetre of the thread. The string rests on the thread, so the thread's points shape every
 //!   note. The bridge's points matter only where the vibrating string reaches the crest, and
 //!   between points 2 mm apart the bridge's parabola (radius 0.1 m) lies at most 5 µm from its
-//!   chord. Points every 2 mm instead of 1 mm make the live string 17–22 % faster and leave its
+//!   chord. Points every 2 mm instead of 1 mm make the live string 17–23 % faster and leave its
 //!   playing-range figures within the measures' own spread: mean changes of 0.01 cents and
 //!   0.05 dB, at most 0.13 cents and 1.4 dB at one pluck (`docs/performance.md`, stop 29).
 //! - Studio and Reference run the seed's finite-difference scheme (`fd/`). Reference is the
