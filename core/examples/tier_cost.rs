@@ -1,9 +1,11 @@
 //! One string of a tier plucked as `cargo xtask bench`'s one-string scene plucks it, timed:
-//! `cargo run --release --example tier_cost -- [TIER] [SECONDS] [RUNS]` (defaults: reference, 3,
-//! 5). Prints the real-time factor of each run and the fastest, with a checksum of the output so
+//! `cargo run --release --example tier_cost -- [TIER] [SECONDS] [RUNS] [KEY]` (defaults: reference,
+//! 3, 5, and the bench's own string; KEY is a MIDI note, as the bench's timing at every key sets
+//! it). Prints the real-time factor of each run and the fastest, with a checksum of the output so
 //! that two builds can be compared for the same arithmetic. A timing loop for profiling and
 //! before/after comparisons in one session; the bench is the figure of record.
 
+use javari_core::engine::pitch::note_to_hz;
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
@@ -18,10 +20,14 @@ fn main() {
     let quality = Quality::from_name(&tier).unwrap_or_else(|| panic!("unknown tier {tier}"));
     let seconds: f64 = args.next().map_or(3.0, |s| s.parse().expect("seconds"));
     let runs: usize = args.next().map_or(5, |s| s.parse().expect("runs"));
-    let settings = VoiceSettings {
+    let key: Option<u8> = args.next().map(|s| s.parse().expect("key"));
+    let mut settings = VoiceSettings {
         quality,
         ..VoiceSettings::default()
     };
+    if let Some(key) = key {
+        settings.fundamental_hz = note_to_hz(key);
+    }
     let blocks = (seconds * SAMPLE_RATE / BLOCK as f64).ceil() as usize;
     let mut best = 0.0_f64;
     for run in 0..runs {

@@ -67,6 +67,7 @@ pub fn contact_case(gap: f64, step: f64) -> (bool, bool) {
 /// The crossing point c of the exact finish (`docs/modal-tanpura.md`, section 4): its gap
 /// before the step, its step `s⁰` at the evaluation point, its law and the law's force and `c`
 /// there, `w_c` of the direction `w = J⁻¹ G e_c`, and Newton's update `δ_c`.
+#[derive(Debug, Clone, Copy)]
 pub struct CrossingPoint {
     pub gap: f64,
     pub start: f64,
@@ -78,13 +79,23 @@ pub struct CrossingPoint {
 }
 
 /// The crossing point's own equation `s = s⁰ + δ_c + w_c ρ(s)`, where `ρ(s) = F_c(s) − F_c⁰ +
-/// c_c (s − s⁰)` and, on a crossing, `F_c(s) = P/s + Q s + K` (leaving: `P = ξa²`, `Q = −2ψa`,
-/// `K = 0`; entering: `P = −ξa²`, `Q = −ξ`, `K = 2ξa`), times s: a quadratic. Returns its root
-/// in the crossing case (the one nearer Newton's `s⁰ + δ_c` if both are) and `ρ` there, or
-/// `None` if it has none. Both paths of the solve (`block.rs`, `step.rs`) finish with it.
+/// c_c (s − s⁰)`, solved in each of the point's two possible cases. On a crossing the law is
+/// `F_c(s) = P/s + Q s + K` (leaving: `P = ξa²`, `Q = −2ψa`, `K = 0`; entering: `P = −ξa²`,
+/// `Q = −ξ`, `K = 2ξa`), and the equation times s is a quadratic; its root in the crossing case
+/// (the one nearer Newton's `s⁰ + δ_c` if both are) is taken. If it has none, the point stays in
+/// the case it had before the step (in contact: `P = 0`, `Q = −ξ − 2ψa`, `K = 2ξa`; out: the law
+/// is zero), where the equation is linear, and its root is taken if it lies in that case.
+/// Returns the step and `ρ` there, or `None` if neither case holds a root. Both paths of the
+/// solve (`block.rs`, `step.rs`) finish with it.
 #[inline(always)]
 pub fn exact_crossing_step(point: CrossingPoint) -> Option<(f64, f64)> {
-    let CrossingPoint {
+    exact_step_crossing(&point).or_else(|| exact_step_staying(&point))
+}
+
+/// [`exact_crossing_step`] in the crossing case: the quadratic's root there.
+#[inline(always)]
+fn exact_step_crossing(point: &CrossingPoint) -> Option<(f64, f64)> {
+    let &CrossingPoint {
         gap,
         start,
         law,
@@ -131,6 +142,36 @@ pub fn exact_crossing_step(point: CrossingPoint) -> Option<(f64, f64)> {
         _ => return None,
     };
     let departure = (p / step + q * step + k) - force + stiffness * (step - start);
+    Some((step, departure))
+}
+
+/// [`exact_crossing_step`] in the case the point had before the step, where its law is linear,
+/// `F_c(s) = Q s + K`: `(1 − w (Q + c_c)) s = s⁰ + δ_c + w (K − F_c⁰ − c_c s⁰)`.
+#[inline(always)]
+fn exact_step_staying(point: &CrossingPoint) -> Option<(f64, f64)> {
+    let &CrossingPoint {
+        gap,
+        start,
+        law,
+        force,
+        stiffness,
+        direction: w,
+        delta,
+    } = point;
+    let touching = gap > 0.0;
+    let (q, k) = if touching {
+        (-law.xi - 2.0 * law.psi * gap, 2.0 * law.xi * gap)
+    } else {
+        (0.0, 0.0)
+    };
+    let alpha = 1.0 - w * (q + stiffness);
+    let beta = (start + delta) + w * (k - force - stiffness * start);
+    let step = beta / alpha;
+    let (before, after) = contact_case(gap, step);
+    if !step.is_finite() || before != after {
+        return None;
+    }
+    let departure = (q * step + k) - force + stiffness * (step - start);
     Some((step, departure))
 }
 
@@ -339,8 +380,9 @@ impl<const N: usize> BlockState<N> {
     /// The step solved exactly for the contact cases of the evaluation point when one point `c`
     /// crosses and every other stays in or out (`ContactStep::finish_exactly`, derived in
     /// `docs/modal-tanpura.md`, section 4): with the update `deltas` and `w = J⁻¹ G e_c`, the
-    /// crossing point's own equation is a quadratic in its step. Replaces the steps and returns
-    /// the largest change if every point then lies in the case it was evaluated in.
+    /// crossing point's own equation is a quadratic in its step (or linear, in the case the point
+    /// had). Replaces the steps and returns the largest change if every other point then lies in
+    /// the case it was evaluated in.
     #[inline(always)]
     fn finish_exactly(
         &mut self,
@@ -377,8 +419,10 @@ impl<const N: usize> BlockState<N> {
             } else {
                 self.steps[slot] + deltas[slot] + departure * direction[slot]
             };
+            // The crossing point's case is the one its step was solved in.
             let evaluated = contact_case(self.gaps[slot], self.steps[slot]);
-            if !candidate.is_finite() || contact_case(self.gaps[slot], candidate) != evaluated {
+            let moved = contact_case(self.gaps[slot], candidate) != evaluated;
+            if !candidate.is_finite() || (moved && slot != crossing) {
                 return None;
             }
             candidates[slot] = candidate;
@@ -466,5 +510,81 @@ impl<const N: usize> Active<'_, N> {
             finite &= weight.is_finite();
         }
         finite
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The residual of the crossing point's own equation `s − s⁰ − δ_c − w ρ(s)` at `step`,
+    /// with the law of the case `step` lies in (`midpoint_force_linear_damping`).
+    fn own_equation_residual(point: &CrossingPoint, step: f64) -> f64 {
+        let force = point
+            .law
+            .midpoint_force_linear_damping(point.gap, step)
+            .force;
+        let departure = force - point.force + point.stiffness * (step - point.start);
+        step - point.start - point.delta - point.direction * departure
+    }
+
+    /// A point whose iterate leaves contact but whose step stays in it (or enters but stays
+    /// out): the quadratic of the crossing case has no root there, and the finish takes the
+    /// root of the point's own, linear, case, which solves its equation to round-off.
+    #[test]
+    fn the_finish_solves_the_staying_case_when_the_crossing_case_has_no_root() {
+        let law = HuntCrossley {
+            xi: 2.0e4,
+            psi: 1.0e7,
+        };
+        for (gap, start) in [(1.0e-6, 1.5e-6), (-1.0e-6, -1.5e-6)] {
+            let evaluated = law.midpoint_force_linear_damping(gap, start);
+            // Newton's update points back across the contact edge; the coupling is mild.
+            let point = CrossingPoint {
+                gap,
+                start,
+                law,
+                force: evaluated.force,
+                stiffness: evaluated.stiffness,
+                direction: 1.0e-6,
+                delta: -1.2 * start,
+            };
+            assert!(exact_step_crossing(&point).is_none(), "gap {gap:e}");
+            let (step, departure) = exact_crossing_step(point).expect("a root in the staying case");
+            let (before, after) = contact_case(gap, step);
+            assert_eq!(
+                before, after,
+                "gap {gap:e}: the step {step:e} stays in its case"
+            );
+            let scale = start.abs();
+            let residual = own_equation_residual(&point, step);
+            assert!(residual.abs() <= 1e-14 * scale, "gap {gap:e}: {residual:e}");
+            let expected = point.law.midpoint_force_linear_damping(gap, step).force - point.force
+                + point.stiffness * (step - start);
+            assert!((departure - expected).abs() <= 1e-12 * expected.abs().max(1e-9));
+        }
+    }
+
+    /// When the crossing case holds the root, the finish still takes it there.
+    #[test]
+    fn the_finish_keeps_the_crossing_root_when_there_is_one() {
+        let law = HuntCrossley {
+            xi: 2.0e4,
+            psi: 1.0e7,
+        };
+        let (gap, start) = (1.0e-6, 1.5e-6);
+        let evaluated = law.midpoint_force_linear_damping(gap, start);
+        let point = CrossingPoint {
+            gap,
+            start,
+            law,
+            force: evaluated.force,
+            stiffness: evaluated.stiffness,
+            direction: 1.0e-6,
+            delta: 0.2e-6,
+        };
+        let (step, _) = exact_crossing_step(point).expect("a root");
+        assert_eq!(contact_case(gap, step), (true, false), "{step:e}");
+        assert!(own_equation_residual(&point, step).abs() <= 1e-14 * start);
     }
 }

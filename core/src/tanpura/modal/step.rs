@@ -13,8 +13,9 @@
 //! When exactly one point enters or leaves contact at the evaluation point (its law is then
 //! `P/s + Q s + K`, every other law linear), the update also solves the step exactly for those
 //! contact cases: a second right-hand side through the same factors and one quadratic
-//! (`ContactStep::finish_exactly`, derived in section 4); if every point then lies in the case it
-//! was evaluated in, the step is exact and the iteration stops.
+//! (`ContactStep::finish_exactly`, derived in section 4), or, if the crossing case holds no root,
+//! one linear equation in the case the point had before the step; if every other point then lies
+//! in the case it was evaluated in, the step is exact and the iteration stops.
 //!
 //! **Which points Newton sees.** Only the *tracked* points, those within the tracking band of
 //! contact or loaded at rest, take part; their state lives in compact arrays in slot order, with
@@ -913,9 +914,11 @@ impl ContactStep {
     /// evaluation point `s⁰`. On a crossing the law is `F_c(s) = P/s + Q s + K` (leaving:
     /// `P = ξa²`, `Q = −2ψa`, `K = 0`; entering: `P = −ξa²`, `Q = −ξ`, `K = 2ξa`), so the
     /// point's own equation `s = s⁰ + δ_c + w_c ρ(s)` is a quadratic in s. Its root in the
-    /// crossing case gives the step; it is taken (and the iterate replaced, returning the largest
-    /// change) only if every point is then in the case it was evaluated in, so that the step
-    /// solves the scheme's equations to round-off. Otherwise `None`, and Newton goes on.
+    /// crossing case gives the step, or, if that case holds none, the root of the linear equation
+    /// in the case the point had before the step ([`exact_crossing_step`]); it is taken (and the
+    /// iterate replaced, returning the largest change) only if every other point is then in the
+    /// case it was evaluated in, so that the step solves the scheme's equations to round-off.
+    /// Otherwise `None`, and Newton goes on.
     /// Newton's own iterates converge to the same root quadratically but from far away, one
     /// update for every digit pair (3–4 more updates per crossing with stiff contact).
     #[inline(always)]
@@ -952,8 +955,10 @@ impl ContactStep {
             } else {
                 self.steps[slot] + self.scratch[slot] + departure * self.crossing_direction[slot]
             };
+            // The crossing point's case is the one its step was solved in.
             let evaluated = contact_case(self.gaps[slot], self.steps[slot]);
-            if !candidate.is_finite() || contact_case(self.gaps[slot], candidate) != evaluated {
+            let moved = contact_case(self.gaps[slot], candidate) != evaluated;
+            if !candidate.is_finite() || (moved && slot != crossing) {
                 return None;
             }
             self.candidate[slot] = candidate;
