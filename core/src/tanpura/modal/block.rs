@@ -92,29 +92,37 @@ pub fn exact_crossing_step(point: CrossingPoint) -> Option<(f64, f64)> {
     exact_step_crossing(&point).or_else(|| exact_step_staying(&point))
 }
 
+impl CrossingPoint {
+    /// α and β of the point's own equation times s, `α s² − β s − γ = 0` (γ = w P), for a law
+    /// `P/s + Q s + K`: `α = 1 − w (Q + c_c)`, `β = s⁰ + δ_c + w (K − F_c⁰ − c_c s⁰)`.
+    #[inline(always)]
+    fn own_equation(&self, q: f64, k: f64) -> (f64, f64) {
+        let w = self.direction;
+        let alpha = 1.0 - w * (q + self.stiffness);
+        let beta = (self.start + self.delta) + w * (k - self.force - self.stiffness * self.start);
+        (alpha, beta)
+    }
+
+    /// `ρ(s) = F_c(s) − F_c⁰ + c_c (s − s⁰)` for the law's value `law_force` at `step`.
+    #[inline(always)]
+    fn departure(&self, law_force: f64, step: f64) -> f64 {
+        law_force - self.force + self.stiffness * (step - self.start)
+    }
+}
+
 /// [`exact_crossing_step`] in the crossing case: the quadratic's root there.
 #[inline(always)]
 fn exact_step_crossing(point: &CrossingPoint) -> Option<(f64, f64)> {
-    let &CrossingPoint {
-        gap,
-        start,
-        law,
-        force,
-        stiffness,
-        direction: w,
-        delta,
-    } = point;
+    let (gap, law) = (point.gap, point.law);
     let leaving = gap > 0.0;
     let (p, q, k) = if leaving {
         (law.xi * gap * gap, -2.0 * law.psi * gap, 0.0)
     } else {
         (-law.xi * gap * gap, -law.xi, 2.0 * law.xi * gap)
     };
-    let newton = start + delta;
-    // s − s⁰ − δ_c − w ρ(s) = 0, times s: α s² − β s − γ = 0.
-    let alpha = 1.0 - w * (q + stiffness);
-    let beta = newton + w * (k - force - stiffness * start);
-    let gamma = w * p;
+    let newton = point.start + point.delta;
+    let (alpha, beta) = point.own_equation(q, k);
+    let gamma = point.direction * p;
     let discriminant = beta * beta + 4.0 * alpha * gamma;
     // Also false for a NaN discriminant.
     let real_roots = discriminant >= 0.0;
@@ -141,38 +149,26 @@ fn exact_step_crossing(point: &CrossingPoint) -> Option<(f64, f64)> {
         (_, other) if in_case(other) => other,
         _ => return None,
     };
-    let departure = (p / step + q * step + k) - force + stiffness * (step - start);
-    Some((step, departure))
+    Some((step, point.departure(p / step + q * step + k, step)))
 }
 
 /// [`exact_crossing_step`] in the case the point had before the step, where its law is linear,
-/// `F_c(s) = Q s + K`: `(1 − w (Q + c_c)) s = s⁰ + δ_c + w (K − F_c⁰ − c_c s⁰)`.
+/// `F_c(s) = Q s + K` (P = 0): `α s = β`.
 #[inline(always)]
 fn exact_step_staying(point: &CrossingPoint) -> Option<(f64, f64)> {
-    let &CrossingPoint {
-        gap,
-        start,
-        law,
-        force,
-        stiffness,
-        direction: w,
-        delta,
-    } = point;
-    let touching = gap > 0.0;
-    let (q, k) = if touching {
+    let (gap, law) = (point.gap, point.law);
+    let (q, k) = if gap > 0.0 {
         (-law.xi - 2.0 * law.psi * gap, 2.0 * law.xi * gap)
     } else {
         (0.0, 0.0)
     };
-    let alpha = 1.0 - w * (q + stiffness);
-    let beta = (start + delta) + w * (k - force - stiffness * start);
+    let (alpha, beta) = point.own_equation(q, k);
     let step = beta / alpha;
     let (before, after) = contact_case(gap, step);
     if !step.is_finite() || before != after {
         return None;
     }
-    let departure = (q * step + k) - force + stiffness * (step - start);
-    Some((step, departure))
+    Some((step, point.departure(q * step + k, step)))
 }
 
 impl<const N: usize> BlockState<N> {
@@ -517,6 +513,25 @@ impl<const N: usize> Active<'_, N> {
 mod tests {
     use super::*;
 
+    /// A crossing point of a stiff law with a mild coupling (`w` = 1e-6 m/N), its law
+    /// evaluated at the iterate `start` and Newton's update `delta`.
+    fn evaluated_at(gap: f64, start: f64, delta: f64) -> CrossingPoint {
+        let law = HuntCrossley {
+            xi: 2.0e4,
+            psi: 1.0e7,
+        };
+        let evaluated = law.midpoint_force_linear_damping(gap, start);
+        CrossingPoint {
+            gap,
+            start,
+            law,
+            force: evaluated.force,
+            stiffness: evaluated.stiffness,
+            direction: 1.0e-6,
+            delta,
+        }
+    }
+
     /// The residual of the crossing point's own equation `s − s⁰ − δ_c − w ρ(s)` at `step`,
     /// with the law of the case `step` lies in (`midpoint_force_linear_damping`).
     fn own_equation_residual(point: &CrossingPoint, step: f64) -> f64 {
@@ -533,22 +548,9 @@ mod tests {
     /// root of the point's own, linear, case, which solves its equation to round-off.
     #[test]
     fn the_finish_solves_the_staying_case_when_the_crossing_case_has_no_root() {
-        let law = HuntCrossley {
-            xi: 2.0e4,
-            psi: 1.0e7,
-        };
         for (gap, start) in [(1.0e-6, 1.5e-6), (-1.0e-6, -1.5e-6)] {
-            let evaluated = law.midpoint_force_linear_damping(gap, start);
-            // Newton's update points back across the contact edge; the coupling is mild.
-            let point = CrossingPoint {
-                gap,
-                start,
-                law,
-                force: evaluated.force,
-                stiffness: evaluated.stiffness,
-                direction: 1.0e-6,
-                delta: -1.2 * start,
-            };
+            // Newton's update points back across the contact edge.
+            let point = evaluated_at(gap, start, -1.2 * start);
             assert!(exact_step_crossing(&point).is_none(), "gap {gap:e}");
             let (step, departure) = exact_crossing_step(point).expect("a root in the staying case");
             let (before, after) = contact_case(gap, step);
@@ -568,21 +570,8 @@ mod tests {
     /// When the crossing case holds the root, the finish still takes it there.
     #[test]
     fn the_finish_keeps_the_crossing_root_when_there_is_one() {
-        let law = HuntCrossley {
-            xi: 2.0e4,
-            psi: 1.0e7,
-        };
         let (gap, start) = (1.0e-6, 1.5e-6);
-        let evaluated = law.midpoint_force_linear_damping(gap, start);
-        let point = CrossingPoint {
-            gap,
-            start,
-            law,
-            force: evaluated.force,
-            stiffness: evaluated.stiffness,
-            direction: 1.0e-6,
-            delta: 0.2e-6,
-        };
+        let point = evaluated_at(gap, start, 0.2e-6);
         let (step, _) = exact_crossing_step(point).expect("a root");
         assert_eq!(contact_case(gap, step), (true, false), "{step:e}");
         assert!(own_equation_residual(&point, step).abs() <= 1e-14 * start);
