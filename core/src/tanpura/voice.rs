@@ -61,6 +61,7 @@ pub fn tune_tension<S>(
     }
     Some(())
 }
+
 /// Largest internal oversampling factor.
 pub const MAX_OVERSAMPLE: usize = 8;
 
