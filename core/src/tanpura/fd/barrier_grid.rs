@@ -20,6 +20,7 @@
 use crate::banded::SymmetricBanded;
 use crate::tanpura::contact::{potential_density, HuntCrossley};
 use crate::tanpura::fd::kernels::{Kernels, StencilSegment};
+use pulp::{Simd, WithSimd};
 
 /// One barrier: its points, shape, contact law and per-step work arrays.
 #[derive(Debug, Clone)]
@@ -51,6 +52,9 @@ pub struct BarrierGrid {
     /// The free stencil: first node in `1..=N−4` and weights with fixed nodes zeroed.
     free_first_node: Vec<usize>,
     free_weights: Vec<[f64; 4]>,
+    /// Per point, the free stencil's terms of `I* C I` and `I* f̃` for unit `c` and `f̃`
+    /// ([`StencilProducts`]).
+    stencil_products: Vec<StencilProducts>,
     /// a_i = y_barrier − ỹ^n: positive means the string penetrates the barrier.
     gaps_m: Vec<f64>,
     steps_m: Vec<f64>,
@@ -77,6 +81,190 @@ fn step_at(weights: &[f64; 4], step: &[f64], first: usize) -> f64 {
 fn dot4(weights: &[f64; 4], values: &[f64]) -> f64 {
     let v = &values[..4];
     weights[0] * v[0] + weights[1] * v[1] + weights[2] * v[2] + weights[3] * v[3]
+}
+
+/// Entries of the lower triangle of a four-node stencil's `w wᵀ`, in the order (0,0), (1,0),
+/// (1,1), (2,0), …, (3,3): entry (j, k) at `j(j+1)/2 + k`.
+const TRIANGLE_TERMS: usize = 10;
+
+/// What one barrier point adds to the condensed Newton system per unit of its law's results,
+/// on the four nodes of its free stencil: the lower triangle of `I* C I` for `c = 1`
+/// (`scale · w_j w_k`, [`TRIANGLE_TERMS`] of them) and then `I* f̃` for `f̃ = 1`
+/// (`scale · w_j`), padded to sixteen: two AVX-512 vectors (four AVX2), so that a point's
+/// contribution is three (five) multiply-adds into running sums ([`ContactIntoBand`]).
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(align(64))]
+struct StencilProducts([f64; 16]);
+
+impl StencilProducts {
+    fn of(weights: &[f64; 4], scale: f64) -> Self {
+        let mut terms = [0.0; 16];
+        let mut index = 0;
+        for j in 0..4 {
+            for k in 0..=j {
+                terms[index] = scale * weights[j] * weights[k];
+                index += 1;
+            }
+        }
+        for (term, weight) in terms[TRIANGLE_TERMS..].iter_mut().zip(weights) {
+            *term = scale * weight;
+        }
+        Self(terms)
+    }
+}
+
+/// The fused contact pass of the condensed Newton update ([`BarrierGrid::evaluate_into_band`]):
+/// the law at every candidate, and `I* f̃`, `I* C I` summed over the points that share a free
+/// stencil (they are consecutive: candidates are in order along the string) before each sum is
+/// added to the node forces and the band. Adding every point straight into memory made each
+/// point wait for the previous one's stores to the same fourteen entries (perf at the
+/// reference tier's key 64: the loads of `node_forces` were the hottest instructions of the
+/// step). The running sums are vector registers: with eight lanes, the triangle's sixteen terms
+/// in two and the forces' in one (lanes 8..16 of [`StencilProducts`]); with four, the triangle
+/// in three and the forces in two. Other units add each point's terms as before
+/// ([`ContactIntoBand::sum_by_point`]). The law itself stays scalar: its four cases branch.
+struct ContactIntoBand<'a> {
+    grid: &'a BarrierGrid,
+    step: &'a [f64],
+    node_forces: &'a mut [f64],
+    band: &'a mut [[f64; 4]],
+    band_first_node: usize,
+}
+
+impl ContactIntoBand<'_> {
+    /// Adds the sums of the points whose free stencil starts at `first`: the triangle's from
+    /// `stiffness_sums`, the node forces' from `force_sums` (both laid out as
+    /// [`StencilProducts`]).
+    #[inline(always)]
+    fn add_stencil_sums(
+        &mut self,
+        first: usize,
+        stiffness_sums: &[f64; 16],
+        force_sums: &[f64; 16],
+    ) {
+        let nodes = &mut self.node_forces[first..first + 4];
+        for (node, sum) in nodes.iter_mut().zip(&force_sums[TRIANGLE_TERMS..]) {
+            *node += sum;
+        }
+        // Row j of the block holds entry (j, k) at offset j − k.
+        let rows = &mut self.band[first - self.band_first_node..][..4];
+        let mut index = 0;
+        for (j, row) in rows.iter_mut().enumerate() {
+            for k in 0..=j {
+                row[j - k] += stiffness_sums[index];
+                index += 1;
+            }
+        }
+    }
+}
+
+impl WithSimd for ContactIntoBand<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(mut self, simd: S) {
+        let grid = self.grid;
+        let step = self.step;
+        let candidates = &grid.candidates[..grid.candidate_count];
+        let (free_first, free_weights) = (&grid.free_first_node[..], &grid.free_weights[..]);
+        let (gaps, products, law) = (&grid.gaps_m[..], &grid.stencil_products[..], grid.law);
+        // Sixteen terms in two vectors of eight lanes or four of four; other units add each
+        // point's terms as scalars.
+        let lanes = S::F64_LANES;
+        if lanes != 8 && lanes != 4 {
+            return self.sum_by_point(law);
+        }
+        let zero = simd.splat_f64s(0.0);
+        let (mut c0, mut c1, mut c2) = (zero, zero, zero);
+        let (mut f1, mut f2, mut f3) = (zero, zero, zero);
+        let mut summed_stencil = None;
+        for &i in candidates {
+            let first = free_first[i];
+            let point_step = step_at(&free_weights[i], step, first);
+            let contact = law.midpoint_force(gaps[i], point_step);
+            if contact.stiffness == 0.0 && contact.force == 0.0 {
+                continue;
+            }
+            if summed_stencil != Some(first) {
+                if let Some(previous) = summed_stencil {
+                    self.flush::<S>(simd, previous, [c0, c1, c2], [f1, f2, f3]);
+                    (c0, c1, c2, f1, f2, f3) = (zero, zero, zero, zero, zero, zero);
+                }
+                summed_stencil = Some(first);
+            }
+            let (terms, _) = S::as_simd_f64s(&products[i].0);
+            let stiffness = simd.splat_f64s(contact.stiffness);
+            let force = simd.splat_f64s(contact.force);
+            if lanes == 8 {
+                // Terms 0..8 and 8..16: the triangle in both, the forces in the second.
+                c0 = simd.mul_add_e_f64s(stiffness, terms[0], c0);
+                c1 = simd.mul_add_e_f64s(stiffness, terms[1], c1);
+                f1 = simd.mul_add_e_f64s(force, terms[1], f1);
+            } else {
+                // Terms 0..4, 4..8, 8..12, 12..16: the triangle in the first three, the forces
+                // in the last two.
+                c0 = simd.mul_add_e_f64s(stiffness, terms[0], c0);
+                c1 = simd.mul_add_e_f64s(stiffness, terms[1], c1);
+                c2 = simd.mul_add_e_f64s(stiffness, terms[2], c2);
+                f2 = simd.mul_add_e_f64s(force, terms[2], f2);
+                f3 = simd.mul_add_e_f64s(force, terms[3], f3);
+            }
+        }
+        if let Some(previous) = summed_stencil {
+            self.flush::<S>(simd, previous, [c0, c1, c2], [f1, f2, f3]);
+        }
+    }
+}
+
+impl ContactIntoBand<'_> {
+    /// Stores the vector sums (the first `16 / lanes` chunks of the triangle's, and the
+    /// force chunks `1..` of `force_sums` for eight lanes, `2..` for four) and adds them.
+    #[inline(always)]
+    fn flush<S: Simd>(
+        &mut self,
+        _simd: S,
+        first: usize,
+        stiffness_sums: [S::f64s; 3],
+        force_sums: [S::f64s; 3],
+    ) {
+        let (mut stiffness, mut force) = ([0.0; 16], [0.0; 16]);
+        let lanes = S::F64_LANES;
+        {
+            let (stiffness_out, _) = S::as_mut_simd_f64s(&mut stiffness);
+            let (force_out, _) = S::as_mut_simd_f64s(&mut force);
+            if lanes == 8 {
+                stiffness_out[0] = stiffness_sums[0];
+                stiffness_out[1] = stiffness_sums[1];
+                force_out[1] = force_sums[0];
+            } else {
+                stiffness_out[..3].copy_from_slice(&stiffness_sums);
+                force_out[2] = force_sums[1];
+                force_out[3] = force_sums[2];
+            }
+        }
+        self.add_stencil_sums(first, &stiffness, &force);
+    }
+
+    /// The same sums one point at a time, for units of other widths than eight or four lanes.
+    fn sum_by_point(&mut self, law: HuntCrossley) {
+        let grid = self.grid;
+        for &i in &grid.candidates[..grid.candidate_count] {
+            let first = grid.free_first_node[i];
+            let point_step = step_at(&grid.free_weights[i], self.step, first);
+            let contact = law.midpoint_force(grid.gaps_m[i], point_step);
+            if contact.stiffness == 0.0 && contact.force == 0.0 {
+                continue;
+            }
+            let terms = &grid.stencil_products[i].0;
+            let mut stiffness = [0.0; 16];
+            let mut force = [0.0; 16];
+            for k in 0..16 {
+                stiffness[k] = contact.stiffness * terms[k];
+                force[k] = contact.force * terms[k];
+            }
+            self.add_stencil_sums(first, &stiffness, &force);
+        }
+    }
 }
 
 /// Added to a segment's gap bound before it is compared with the candidate margin: far above
@@ -194,6 +382,7 @@ impl BarrierGrid {
             kernels: Kernels::detect(),
             free_first_node: vec![1; capacity],
             free_weights: vec![[0.0; 4]; capacity],
+            stencil_products: vec![StencilProducts::default(); capacity],
             gaps_m: vec![0.0; capacity],
             steps_m: vec![0.0; capacity],
             forces: vec![0.0; capacity],
@@ -239,6 +428,7 @@ impl BarrierGrid {
             let (free_first, free_weights) = free_stencil(first, weights, self.string_intervals);
             self.free_first_node[i] = free_first;
             self.free_weights[i] = free_weights;
+            self.stencil_products[i] = StencilProducts::of(&free_weights, self.transpose_scale);
             self.lebesgue = self
                 .lebesgue
                 .max(weights.iter().map(|w| w.abs()).sum::<f64>());
@@ -448,40 +638,29 @@ impl BarrierGrid {
         band: &mut [[f64; 4]],
         first_node: usize,
     ) {
-        let scale = self.transpose_scale;
-        for &i in &self.candidates[..self.candidate_count] {
-            let first = self.free_first_node[i];
-            let w = &self.free_weights[i];
-            let contact = self
-                .law
-                .midpoint_force(self.gaps_m[i], step_at(w, step, first));
-            if contact.stiffness == 0.0 && contact.force == 0.0 {
-                continue;
-            }
-            let force = scale * contact.force;
-            let nodes: &mut [f64; 4] = (&mut node_forces[first..first + 4])
-                .try_into()
-                .expect("four nodes");
-            for (node, weight) in nodes.iter_mut().zip(w) {
-                *node += weight * force;
-            }
-            // Rows first..first + 4 of I* C I: row j holds c w_j w_k at offset j − k ≤ j.
-            let rows: &mut [[f64; 4]; 4] = (&mut band[first - first_node..][..4])
-                .try_into()
-                .expect("four rows");
-            let c = scale * contact.stiffness;
-            for j in 0..4 {
-                let scaled = c * w[j];
-                for k in 0..=j {
-                    rows[j][j - k] += scaled * w[k];
-                }
-            }
-        }
+        self.kernels.arch.dispatch(ContactIntoBand {
+            grid: self,
+            step,
+            node_forces,
+            band,
+            band_first_node: first_node,
+        });
     }
 
     /// Evaluates the candidates at the step `step` (as [`BarrierGrid::evaluate`]) and adds
     /// `I* f̃` into the full-node vector `node_forces`, in one pass.
+    ///
+    /// The forces of points that share a stencil are summed before they are added to the
+    /// nodes, as in [`BarrierGrid::evaluate_into_band`].
     pub fn evaluate_forces_into(&mut self, step: &[f64], node_forces: &mut [f64]) {
+        let mut sums = [0.0; 4];
+        let mut summed_stencil = None;
+        let add_sums = |node_forces: &mut [f64], first: usize, sums: &mut [f64; 4]| {
+            for (node, sum) in node_forces[first..first + 4].iter_mut().zip(&*sums) {
+                *node += sum;
+            }
+            *sums = [0.0; 4];
+        };
         for &i in &self.candidates[..self.candidate_count] {
             let first = self.free_first_node[i];
             let w = &self.free_weights[i];
@@ -492,11 +671,20 @@ impl BarrierGrid {
             self.jacobian[i] = contact.stiffness;
             self.squared_gap_changes[i] = contact.squared_gap_change;
             if contact.force != 0.0 {
+                if summed_stencil != Some(first) {
+                    if let Some(previous) = summed_stencil {
+                        add_sums(node_forces, previous, &mut sums);
+                    }
+                    summed_stencil = Some(first);
+                }
                 let force = self.transpose_scale * contact.force;
-                for (node, weight) in node_forces[first..first + 4].iter_mut().zip(w) {
-                    *node += weight * force;
+                for (sum, weight) in sums.iter_mut().zip(w) {
+                    *sum += weight * force;
                 }
             }
+        }
+        if let Some(previous) = summed_stencil {
+            add_sums(node_forces, previous, &mut sums);
         }
     }
 
@@ -742,5 +930,100 @@ mod tests {
                 .map(|i| grid.forces[i] * grid.steps_m[i])
                 .sum::<f64>();
         assert!((string_work - barrier_work).abs() < 1e-12 * barrier_work.abs());
+    }
+
+    /// The fused pass of the condensed update adds the same `I* f̃` and `I* C I` as the per-point
+    /// assembly, on every vector width its sums are written for (one point at a time, four and
+    /// eight lanes, and the units of this machine), with stencils that reach the fixed end.
+    #[test]
+    fn the_fused_pass_matches_the_per_point_assembly_on_every_vector_unit() {
+        let intervals = 40;
+        let dx = 0.005;
+        let mut grid = BarrierGrid::with_capacity(120, intervals);
+        grid.place(0.0004, 0.0011, 110, dx, |x| 2e-4 * (1.0 - 20.0 * x));
+        grid.set_law(1e9, 1e-3, 1e-5, 5e-4);
+        // A string across the barrier: some points stay in contact, some enter, some leave.
+        let displacement: Vec<f64> = (0..=intervals)
+            .map(|m| {
+                let x = m as f64 * dx;
+                if m == 0 || m == intervals {
+                    0.0
+                } else {
+                    2e-4 * (1.0 - 20.0 * x) + 3e-5 * (90.0 * x).sin()
+                }
+            })
+            .collect();
+        grid.begin_step(&displacement, 1e-4);
+        let mut step: Vec<f64> = (0..=intervals)
+            .map(|m| 2e-5 * (m as f64 * 0.9).cos())
+            .collect();
+        (step[0], step[intervals]) = (0.0, 0.0);
+        let (first, last) = grid.candidate_node_range().expect("candidates");
+        assert!(first == 1, "the test's stencils must reach the fixed end");
+
+        grid.evaluate(&step);
+        let mut expected_forces = vec![0.0; intervals + 1];
+        grid.spread_forces(&mut expected_forces);
+        let mut expected_band = vec![[0.0; 4]; last - first + 1];
+        grid.for_each_jacobian_entry(|row, column, value| {
+            if column <= row {
+                expected_band[row - first][row - column] += value;
+            }
+        });
+        let cases = (0..grid.len()).filter(|&i| grid.forces[i] != 0.0).count();
+        assert!(cases > 10, "only {cases} points exert a force");
+
+        let check_forces = |unit: &str, forces: &[f64]| {
+            let scale = expected_forces.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
+            for (node, (got, want)) in forces.iter().zip(&expected_forces).enumerate() {
+                assert!((got - want).abs() <= 1e-13 * scale, "{unit}: node {node}");
+            }
+        };
+        let check = |unit: &str, forces: &[f64], band: &[[f64; 4]]| {
+            check_forces(unit, forces);
+            let scale = expected_band
+                .iter()
+                .flatten()
+                .fold(0.0_f64, |m, c| m.max(c.abs()));
+            for (row, (got, want)) in band.iter().zip(&expected_band).enumerate() {
+                for k in 0..4 {
+                    let error = (got[k] - want[k]).abs();
+                    assert!(error <= 1e-13 * scale, "{unit}: row {row}, offset {k}");
+                }
+            }
+        };
+        let run = |unit: &str, vectorize: &dyn Fn(ContactIntoBand)| {
+            let mut forces = vec![0.0; intervals + 1];
+            let mut band = vec![[0.0; 4]; last - first + 1];
+            vectorize(ContactIntoBand {
+                grid: &grid,
+                step: &step,
+                node_forces: &mut forces,
+                band: &mut band,
+                band_first_node: first,
+            });
+            check(unit, &forces, &band);
+        };
+        run("scalar", &|op| pulp::Scalar.vectorize(op));
+        run("two lanes", &|op| pulp::Scalar128b.vectorize(op));
+        run("four lanes", &|op| pulp::Scalar256b.vectorize(op));
+        run("eight lanes", &|op| pulp::Scalar512b.vectorize(op));
+        #[cfg(target_arch = "x86_64")]
+        {
+            if let Some(simd) = pulp::x86::V3::try_new() {
+                run("AVX2", &|op| Simd::vectorize(simd, op));
+            }
+            if let Some(simd) = pulp::x86::V4::try_new() {
+                run("AVX-512", &|op| Simd::vectorize(simd, op));
+            }
+        }
+        let mut forces = vec![0.0; intervals + 1];
+        let mut band = vec![[0.0; 4]; last - first + 1];
+        grid.evaluate_into_band(&step, &mut forces, &mut band, first);
+        check("dispatched", &forces, &band);
+
+        let mut forces = vec![0.0; intervals + 1];
+        grid.evaluate_forces_into(&step, &mut forces);
+        check_forces("forces only", &forces);
     }
 }
