@@ -116,13 +116,14 @@ impl StencilProducts {
 /// The fused contact pass of the condensed Newton update ([`BarrierGrid::evaluate_into_band`]):
 /// the law at every candidate, and `I* f̃`, `I* C I` summed over the points that share a free
 /// stencil (they are consecutive: candidates are in order along the string) before each sum is
-/// added to the node forces and the band. Adding every point straight into memory made each
-/// point wait for the previous one's stores to the same fourteen entries (perf at the
-/// reference tier's key 64: the loads of `node_forces` were the hottest instructions of the
-/// step). The running sums are vector registers: with eight lanes, the triangle's sixteen terms
-/// in two and the forces' in one (lanes 8..16 of [`StencilProducts`]); with four, the triangle
-/// in three and the forces in two. Other units add each point's terms as before
-/// ([`ContactIntoBand::sum_by_point`]). The law itself stays scalar: its four cases branch.
+/// added to the node forces and the band, instead of each point's fourteen terms being added
+/// to memory one point after the other. The running sums are vector registers: with eight
+/// lanes, the triangle's sixteen terms in two and the forces' in one (lanes 8..16 of
+/// [`StencilProducts`]); with four, the triangle in three and the forces in two. Other units
+/// add each point's terms as before ([`ContactIntoBand::sum_by_point`]). The law itself stays
+/// scalar. With this pass the reference tier's whole step runs 10 % faster at key 64
+/// (`docs/performance.md`, "Stop 31"); kept as fourteen scalar sums in the generic build, it
+/// was slower (stop 26: they spill from SSE2's sixteen registers).
 struct ContactIntoBand<'a> {
     grid: &'a BarrierGrid,
     step: &'a [f64],
