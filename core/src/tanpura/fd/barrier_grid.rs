@@ -218,8 +218,9 @@ impl WithSimd for ContactIntoBand<'_> {
 }
 
 impl ContactIntoBand<'_> {
-    /// Stores the vector sums (the first `16 / lanes` chunks of the triangle's, and the
-    /// force chunks `1..` of `force_sums` for eight lanes, `2..` for four) and adds them.
+    /// Stores the vector sums in [`StencilProducts`]'s layout and adds them: with eight lanes,
+    /// `stiffness_sums[0..2]` are chunks 0–1 and `force_sums[0]` is chunk 1; with four,
+    /// `stiffness_sums` are chunks 0–2 and `force_sums[1..3]` are chunks 2–3.
     #[inline(always)]
     fn flush<S: Simd>(
         &mut self,
