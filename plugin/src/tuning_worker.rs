@@ -8,7 +8,7 @@
 //! Both directions are lock-free fixed-size queues (`crossbeam::queue::ArrayQueue`): the audio
 //! thread only pushes and pops, never waits, locks or allocates (a full queue drops the request;
 //! the engine asks again at the string's next pluck). The worker polls every
-//! [`POLL_INTERVAL`] when idle, and stops when the plugin is dropped.
+//! `POLL_INTERVAL` when idle, and stops when the plugin is dropped.
 
 use crossbeam::queue::ArrayQueue;
 use javari_core::engine::Engine;

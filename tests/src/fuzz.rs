@@ -3,7 +3,7 @@
 //! corpus and every input that once failed through the same functions. A check panics when the
 //! code under test breaks its promise; an input the code refuses with an error is a pass.
 //!
-//! - [`midi_file`]: bytes → `midi_file::parse` → a score whose times are finite, sorted and
+//! - [`midi_file()`]: bytes → `midi_file::parse` → a score whose times are finite, sorted and
 //!   non-negative, with no more events than the file has bytes, or an error naming the file;
 //! - [`preset_text`]: text → `Preset::parse` → settings that write back to the same preset, or
 //!   an error naming the file and a line that exists;

@@ -24,8 +24,8 @@ thread_local! {
     static REAL_PLANNER: RefCell<RealFftPlanner<f64>> = RefCell::new(RealFftPlanner::new());
 }
 
-/// In-place forward complex DFT, unnormalised: X[k] = Σ x[j] e^{−2πi jk/n} (any length; powers of
-/// two are the fastest). Allocates a buffer per call: not for the audio thread.
+/// In-place forward complex DFT, unnormalised: `X[k] = Σ x[j] e^{−2πi jk/n}` (any length;
+/// powers of two are the fastest). Allocates a buffer per call: not for the audio thread.
 pub fn fft(re: &mut [f64], im: &mut [f64]) {
     let n = re.len();
     assert_eq!(im.len(), n, "FFT real and imaginary parts differ in length");
@@ -69,7 +69,7 @@ pub fn power_spectrum(signal: &[f64], start: usize, n: usize, fft_size: usize) -
     spectrum.iter().map(|bin| bin.norm_sqr()).collect()
 }
 
-/// |Σ x[i] w[i] e^{−2πi f i / fs}|² for one frequency (Hann-windowed DFT at any frequency).
+/// `|Σ x[i] w[i] e^{−2πi f i / fs}|²` for one frequency (Hann-windowed DFT at any frequency).
 pub fn windowed_dft_power<T: Copy + Into<f64>>(
     signal: &[T],
     sample_rate_hz: f64,

@@ -5,7 +5,7 @@
 //! - a pool of [`TanpuraVoice`] strings (polyphonic). A string rings on after note-off, as a real
 //!   string does; a voice is taken from another string only by a new pluck: a string already
 //!   tuned to the note is plucked again, else a silent voice is used, else the quietest (then the
-//!   oldest) ringing one is stolen ([`Engine::choose_voice`]);
+//!   oldest) ringing one is stolen (`Engine::choose_voice`);
 //! - note to pitch: 12-TET from a reference A4 (415–466 Hz) with fine tuning ([`pitch`]);
 //! - drone mode ([`drone`]): a held note (or the settings' Sa) sets Sa and the strings (4, 5 or
 //!   6, each with its own fine tuning, level and thread) are plucked in the cycle at the host's
@@ -34,7 +34,7 @@
 //!   between two activations applies to each string from its next pluck, and the plugin asks
 //!   the host to restart it so that the reported latency follows ([`Engine::tier_latency_samples`]
 //!   says what it will be). A voice whose own latency is lower than the reported one is delayed
-//!   to match ([`OutputDelay`]); one whose latency is higher (an FD string still ringing after a
+//!   to match (`OutputDelay`); one whose latency is higher (an FD string still ringing after a
 //!   switch to a modal tier, until the host restarts the plugin) sounds that much late.
 //!
 //! Lifecycle (design.md): [`Engine::new`] allocates every voice; [`Engine::process`],

@@ -1,5 +1,5 @@
 //! Presets: a readable TOML file of top-level `key = value` lines mapped onto
-//! [`EngineSettings`]. The `toml` crate reads it through serde ([`PresetFile`]); this module adds
+//! [`EngineSettings`]. The `toml` crate reads it through serde (`PresetFile`); this module adds
 //! the ranges and the error messages.
 //!
 //! Every key names its unit. `#` starts a comment; strings are quoted ("classic"), switches are

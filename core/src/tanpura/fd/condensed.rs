@@ -29,7 +29,7 @@
 //! node; the recovery reads it only where it is above 2⁻⁶⁰ of its peak (on the seed's string
 //! within 17 nodes of the contact node, of 199; test
 //! `reference_grid_columns_are_significant_near_their_node_only`), which leaves out less than the
-//! round-off of the correction ([`RESPONSE_CUTOFF`]).
+//! round-off of the correction (`RESPONSE_CUTOFF`).
 //! Energy stability is untouched: the accepted `s` solves the same discrete equations (to the
 //! Newton tolerance), so the discrete energy balance of the full scheme holds as before. `G` and
 //! the influence columns depend only on `A`, so they are recomputed only when the string's
