@@ -561,8 +561,9 @@ fn progress_line(
 }
 
 /// [`render_blocks_calibrated`] with the voices of each segment on `jobs` threads (rayon); one
-/// job renders on this thread exactly as the plugin does. The voices' outputs are summed in a fixed order
-/// ([`javari_core::engine::Engine::process_with`]), so the signal does not depend on `jobs`.
+/// job renders on this thread exactly as the plugin does. The voices' outputs are summed in a
+/// fixed order ([`javari_core::engine::Engine::process_with`]), so the signal does not depend on
+/// `jobs`.
 fn render_on(
     jobs: usize,
     settings: &EngineSettings,

@@ -8,7 +8,8 @@
 //! intervals and oversampling and the barrier's points as they are (finer than any of these
 //! grids), configured, tuned by the voice's own [`tune_tension`] (passes of
 //! `T ← T (f / f_lin)²` on the linearised fundamental), plucked and picked up as the reference
-//! tier's voice does, through the tiers' Kaiser decimator. With `refinement = 1` it is the reference tier's string itself.
+//! tier's voice does, through the tiers' Kaiser decimator. With `refinement = 1` it is the
+//! reference tier's string itself.
 //! Offline only: it allocates, and N = 800 at 16× does 16 times the reference tier's work per
 //! second of sound (slower than real time).
 //!

@@ -188,7 +188,7 @@ impl WithSimd for ContactIntoBand<'_> {
             }
             if summed_stencil != Some(first) {
                 if let Some(previous) = summed_stencil {
-                    self.flush::<S>(simd, previous, [c0, c1, c2], [f1, f2, f3]);
+                    self.flush::<S>(previous, [c0, c1, c2], [f1, f2, f3]);
                     (c0, c1, c2, f1, f2, f3) = (zero, zero, zero, zero, zero, zero);
                 }
                 summed_stencil = Some(first);
@@ -212,7 +212,7 @@ impl WithSimd for ContactIntoBand<'_> {
             }
         }
         if let Some(previous) = summed_stencil {
-            self.flush::<S>(simd, previous, [c0, c1, c2], [f1, f2, f3]);
+            self.flush::<S>(previous, [c0, c1, c2], [f1, f2, f3]);
         }
     }
 }
@@ -224,7 +224,6 @@ impl ContactIntoBand<'_> {
     #[inline(always)]
     fn flush<S: Simd>(
         &mut self,
-        _simd: S,
         first: usize,
         stiffness_sums: [S::f64s; 3],
         force_sums: [S::f64s; 3],

@@ -910,8 +910,8 @@ impl ContactStep {
     /// crosses (enters or leaves contact) and every other point stays in or out, where the law is
     /// linear in its step (`docs/modal-tanpura.md`, section 4). With the Newton update `δ` (in
     /// `scratch`) and `w = J⁻¹ G e_c`, the exact step is `Δu + δ + ρ w`, where
-    /// `ρ(s) = F_c(s) − F_c⁰ + c_c (s − s⁰)` is the crossing law's departure from its tangent at the
-    /// evaluation point `s⁰`. On a crossing the law is `F_c(s) = P/s + Q s + K` (leaving:
+    /// `ρ(s) = F_c(s) − F_c⁰ + c_c (s − s⁰)` is the crossing law's departure from its tangent at
+    /// the evaluation point `s⁰`. On a crossing the law is `F_c(s) = P/s + Q s + K` (leaving:
     /// `P = ξa²`, `Q = −2ψa`, `K = 0`; entering: `P = −ξa²`, `Q = −ξ`, `K = 2ξa`), so the
     /// point's own equation `s = s⁰ + δ_c + w_c ρ(s)` is a quadratic in s. Its root in the
     /// crossing case gives the step, or, if that case holds none, the root of the linear equation
