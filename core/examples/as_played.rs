@@ -2,13 +2,14 @@
 //! tier, with the linearised tuning alone and with the as-played calibration
 //! (`tanpura/as_played.rs`): `cargo run --release -p javari-core --example as_played -- TIER KEY…`
 //! (TIER: draft, live, studio or reference; keys default to 36–64; an argument such as `41mm`
-//! moves the thread from its 40 mm). One row per key, one column per MIDI velocity, cents from
-//! the key's pitch; the last column is the largest deviation at velocities 40–110.
+//! moves the thread from its 40 mm). One row per key: the calibration's offset (cents) and thread
+//! move (mm), then one column per MIDI velocity, cents from the key's pitch, with the linearised
+//! tuning and as played; each block's last column is the largest deviation at velocities 40–110.
 
 use javari_core::analysis::cents;
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::tanpura::as_played::{
-    as_played_offset_cents, sustained_pitch_of_pluck_hz, NOTE_VELOCITIES,
+    as_played_calibration, sustained_pitch_of_pluck_hz, NOTE_VELOCITIES,
 };
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
@@ -71,7 +72,7 @@ fn main() {
                         thread_position_m,
                         ..VoiceSettings::default()
                     };
-                    let offset = as_played_offset_cents(
+                    let as_played = as_played_calibration(
                         &settings,
                         &Pluck::default(),
                         NOTE_VELOCITIES,
@@ -79,10 +80,18 @@ fn main() {
                     );
                     let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
                     let linearised = row(&mut voice, key, 0.0);
-                    let played = row(&mut voice, key, offset);
-                    rows.lock()
-                        .expect("a row thread panicked")
-                        .push((key, offset, linearised, played));
+                    voice.set_settings(&VoiceSettings {
+                        thread_position_m: settings.thread_position_m + as_played.thread_offset_m,
+                        ..settings
+                    });
+                    let played = row(&mut voice, key, as_played.offset_cents);
+                    rows.lock().expect("a row thread panicked").push((
+                        key,
+                        as_played.offset_cents,
+                        as_played.thread_offset_m,
+                        linearised,
+                        played,
+                    ));
                 }
             });
         }
@@ -94,12 +103,16 @@ fn main() {
         quality.name(),
         thread_position_m * 1000.0
     );
-    println!("key  offset | linearised tuning                                | worst | as played                                        | worst");
+    println!("key  offset thread | linearised tuning                                | worst | as played                                        | worst");
     let (mut worst_linearised, mut worst_played): (f64, f64) = (0.0, 0.0);
-    for (key, offset, linearised, played) in rows {
+    for (key, offset, thread_m, linearised, played) in rows {
         println!(
-            "{key:>3} {offset:>7.2} |{}| {:>5.2} |{}| {:>5.2}",
-            linearised.0, linearised.1, played.0, played.1
+            "{key:>3} {offset:>7.2} {:>+6.2} |{}| {:>5.2} |{}| {:>5.2}",
+            thread_m * 1000.0,
+            linearised.0,
+            linearised.1,
+            played.0,
+            played.1
         );
         worst_linearised = worst_linearised.max(linearised.1);
         worst_played = worst_played.max(played.1);

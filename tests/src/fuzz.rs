@@ -427,6 +427,8 @@ pub fn engine_events(bytes: &[u8]) {
                         request,
                         sample_rate_hz: SAMPLE_RATE_HZ,
                         offset_cents: offset.scaled(-50.0, 50.0),
+                        // Past the ±0.3 mm a calibration can find: the engine clamps it.
+                        thread_offset_m: offset.scaled(-1e-3, 1e-3),
                     };
                     assert_no_alloc(|| engine.set_calibration(&calibration));
                 }

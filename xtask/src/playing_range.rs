@@ -128,16 +128,25 @@ fn calibration_cache_file(
     format!("{:?}", settings_for(Quality::Reference, &point)).hash(&mut hasher);
     key.hash(&mut hasher);
     sample_rate_hz.to_bits().hash(&mut hasher);
-    directory.join(format!("{:016x}.cents", hasher.finish()))
+    directory.join(format!("{:016x}.asplayed", hasher.finish()))
 }
 
-fn read_cached_offset(path: &Path) -> Option<f64> {
-    std::fs::read_to_string(path).ok()?.trim().parse().ok()
+/// A cached calibration: its offset in cents and its thread move in metres.
+fn read_cached_calibration(path: &Path) -> Option<(f64, f64)> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut numbers = text.split_whitespace().map(str::parse::<f64>);
+    let offset_cents = numbers.next()?.ok()?;
+    let thread_offset_m = numbers.next()?.ok()?;
+    Some((offset_cents, thread_offset_m))
 }
 
-fn write_cached_offset(path: &Path, offset_cents: f64) {
+fn write_cached_calibration(path: &Path, calibration: &Calibration) {
     let temporary = path.with_extension("partial");
-    if std::fs::write(&temporary, format!("{offset_cents:e}")).is_ok() {
+    let text = format!(
+        "{:e} {:e}",
+        calibration.offset_cents, calibration.thread_offset_m
+    );
+    if std::fs::write(&temporary, text).is_ok() {
         let _ = std::fs::rename(&temporary, path);
     }
 }
@@ -208,16 +217,19 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
             let path = cache.as_ref().map(|(dir, version)| {
                 calibration_cache_file(dir, version, key, position, sample_rate_hz)
             });
-            if let Some(offset_cents) = path.as_deref().and_then(read_cached_offset) {
+            if let Some((offset_cents, thread_offset_m)) =
+                path.as_deref().and_then(read_cached_calibration)
+            {
                 return Calibration {
                     request: calibration_request(quality, key, position),
                     sample_rate_hz,
                     offset_cents,
+                    thread_offset_m,
                 };
             }
             let measured = calibrate(quality, key, position, sample_rate_hz);
             if let Some(path) = path {
-                write_cached_offset(&path, measured.offset_cents);
+                write_cached_calibration(&path, &measured);
             }
             measured
         })

@@ -461,6 +461,8 @@ struct Slot {
     fundamental_hz: f64,
     /// What its linearised tuning aims at: the note moved by its as-played offset.
     tuned_hz: f64,
+    /// How far its as-played calibration moved its thread, m (`tanpura/as_played.rs`).
+    thread_set_m: f64,
     /// Output scaling that keeps the level independent of pitch (see [`pitch_level_factor`]),
     /// fixed at the pluck.
     pitch_level: f64,
@@ -646,6 +648,7 @@ impl Engine {
                 key: None,
                 fundamental_hz: voice.fundamental_hz,
                 tuned_hz: voice.fundamental_hz,
+                thread_set_m: 0.0,
                 pitch_level: 1.0,
                 level_factor: 1.0,
                 pan: 0.0,
@@ -1224,6 +1227,7 @@ impl Engine {
             if let Some(StringKey::Drone(index)) = slot.key {
                 string_settings.thread_position_m += drone_strings[index].thread_offset_m;
             }
+            string_settings.thread_position_m += slot.thread_set_m;
             let mut string_settings = string_settings.clamped();
             // A voice switching tier restarts at rest (`TanpuraVoice::set_settings`), so a
             // ringing string keeps its tier; the new one applies from its next pluck.
@@ -1397,6 +1401,7 @@ impl Engine {
     fn pluck_string(&mut self, key: StringKey, fundamental_hz: f64, velocity: f32) {
         let index = self.choose_voice(key, fundamental_hz);
         let mut string_settings = self.string_settings(key, fundamental_hz);
+        let mut thread_set_m = 0.0;
         if self.target.tuning.as_played {
             let velocities = match key {
                 StringKey::Drone(_) => drone_velocities(&self.target.drone),
@@ -1411,7 +1416,10 @@ impl Engine {
                 self.want_calibration(&request);
             }
             let offset = self.as_played.offset_cents(&string_settings);
+            thread_set_m = self.as_played.thread_offset_m(&string_settings);
             string_settings.fundamental_hz *= (offset / 1200.0).exp2();
+            string_settings.thread_position_m += thread_set_m;
+            string_settings = string_settings.clamped();
         }
         let level = match key {
             StringKey::Drone(string) => self.drone_levels[string],
@@ -1437,6 +1445,7 @@ impl Engine {
             slot.pitch_level = pitch_level_factor(fundamental_hz);
         }
         slot.tuned_hz = string_settings.fundamental_hz;
+        slot.thread_set_m = thread_set_m;
         slot.pan = pan;
         slot.level_factor = slot.pitch_level * level;
         // Also brings a re-plucked string to the current quality tier.

@@ -438,6 +438,7 @@ fn a_calibration_retunes_its_string_from_the_next_pluck_and_is_asked_for_once() 
         request: planned[0],
         sample_rate_hz: RATE,
         offset_cents: 3.0,
+        thread_offset_m: 0.1e-3,
     };
     assert!(calibration.is_for(&request, RATE));
     engine.set_calibration(&calibration);
@@ -445,6 +446,18 @@ fn a_calibration_retunes_its_string_from_the_next_pluck_and_is_asked_for_once() 
     let slot = &engine.slots[0];
     assert!((slot.tuned_hz / (hz * (3.0f64 / 1200.0).exp2()) - 1.0).abs() < 1e-12);
     assert_eq!(slot.fundamental_hz, hz);
+    // The thread moves with it, and stays moved when a ringing string takes new settings.
+    let thread = |engine: &Engine| engine.slots[0].voice.settings().thread_position_m;
+    let moved = request.settings.thread_position_m + 0.1e-3;
+    assert!((thread(&engine) - moved).abs() < 1e-12);
+    settings.voice.gamma_per_s *= 1.01;
+    engine.set_settings(&settings);
+    run(&mut engine, &[], 4096);
+    assert_eq!(
+        engine.slots[0].voice.settings().gamma_per_s,
+        settings.voice.gamma_per_s
+    );
+    assert!((thread(&engine) - moved).abs() < 1e-12);
     assert_eq!(engine.take_wanted_calibration(), None, "it is current now");
 
     // Off: the linearised tuning only, and nothing is asked for.

@@ -23,20 +23,31 @@
 //! the pitch scales with the target (`f ∝ √T` with the contact state unchanged); the second
 //! pass catches the contact state that the retuning itself moves.
 //!
-//! Where the string at rest just touches the crest the two ends can sound 10 cents apart (a soft
-//! pluck stays on the crest, a firm one lifts it off), and centring them is all a tension can do.
-//! Moving the thread 1 mm settles those notes, but they sit at the jawari's sweet spot and the
-//! move takes 6–13 dB off their level above 2 kHz (`examples/jawari_moves.rs`, README), so the
-//! calibration leaves the thread where the player put it.
+//! **Setting the jawari.** Where the string at rest just touches the crest the two ends can
+//! sound 10 cents apart (a soft pluck stays on the crest, a firm one lifts it off), and centring
+//! them is all a tension can do. A player then moves the string's thread until the note speaks
+//! the same at every strength, keeping the jawari's brightness, and so does the calibration
+//! ([`as_played_calibration`]). After centring, it checks the sustained pitch at the soft end,
+//! midway and the firm end of the string's velocities; if one lies more than [`SETTLED_CENTS`]
+//! from the note, it tries thread moves of [`THREAD_STEP_M`], ±1 to ±[`THREAD_STEPS`] steps
+//! (towards the crest first at each size), centres each again, and keeps the smallest that
+//! puts all three within [`SETTLED_CENTS`] and keeps the string's level above 2 kHz within
+//! [`BRIGHTNESS_KEPT_DB`] of the unmoved string's ([`brightness_db`]); without one the thread
+//! stays where the player put it. The window of thread positions over which a string is bistable
+//! is about 0.15 mm wide and moves by about 0.05 mm a semitone, so moves of 0.05–0.3 mm settle
+//! these notes; a millimetre would also settle them but takes 6–13 dB off their level above
+//! 2 kHz (`examples/jawari_moves.rs`, README).
 //!
-//! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the
-//! string's tier, so a calibration is an offline job (the renderer before it renders, a
-//! background thread in the plugin), never the audio thread's. The result is a plain number of
-//! cents per string that the engine adds to the string's target ([`AsPlayedTuning`]).
+//! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, the check three
+//! more, and each thread move tried a centring and a check again, so a calibration is an
+//! offline job (the renderer before it renders, a background thread in the plugin), never the
+//! audio thread's. The result is a plain number of cents and a thread move per string, which the
+//! engine adds to the string's target and thread position ([`AsPlayedTuning`]).
 
 use super::excitation::Pluck;
 use super::voice::{TanpuraVoice, VoiceSettings};
 use crate::analysis::listening::{sustained_pitch_hz, SUSTAIN_WINDOW_S};
+use crate::analysis::{band_power, power_spectrum};
 
 /// The soft and firm ends of a played note's velocities (MIDI 40 and 110, as fractions of full),
 /// whose sustained pitches a note's calibration centres.
@@ -48,6 +59,17 @@ pub const CALIBRATION_SECONDS: f64 = SUSTAIN_WINDOW_S.1;
 /// Largest offset a calibration may find, cents: beyond it the measurement is not a
 /// fundamental (a string that rings too short to be measured is left at 0).
 pub const MAX_OFFSET_CENTS: f64 = 50.0;
+/// A string is settled when its sustained pitch at the soft end, midway and the firm end of its
+/// velocities lies within this of the note, cents (below the 2 cents a player hears as out of
+/// tune, for the velocities between those three).
+pub const SETTLED_CENTS: f64 = 1.5;
+/// The thread moves a calibration tries on a string that is not settled: multiples of this, m.
+pub const THREAD_STEP_M: f64 = 0.05e-3;
+/// The largest move tried, in steps (±0.3 mm).
+pub const THREAD_STEPS: usize = 6;
+/// A thread move is kept only if the string's level above 2 kHz ([`brightness_db`]) stays within
+/// this of the unmoved string's, dB.
+pub const BRIGHTNESS_KEPT_DB: f64 = 3.0;
 
 /// The sustained pitch of one pluck of `pluck` at `velocity` (0–1) on `voice`, retuned (by
 /// linearisation) to `target_hz` and started from rest, Hz; `nominal_hz` centres the pitch
@@ -60,6 +82,19 @@ pub fn sustained_pitch_of_pluck_hz(
     velocity: f64,
     sample_rate_hz: f64,
 ) -> f64 {
+    let signal = render_pluck(voice, target_hz, pluck, velocity, sample_rate_hz);
+    sustained_pitch_hz(&signal, sample_rate_hz, nominal_hz)
+}
+
+/// [`CALIBRATION_SECONDS`] of one pluck of `pluck` at `velocity` (0–1) on `voice`, retuned (by
+/// linearisation) to `target_hz` and started from rest.
+fn render_pluck(
+    voice: &mut TanpuraVoice,
+    target_hz: f64,
+    pluck: &Pluck,
+    velocity: f64,
+    sample_rate_hz: f64,
+) -> Vec<f64> {
     let settings = VoiceSettings {
         fundamental_hz: target_hz,
         ..*voice.settings()
@@ -72,10 +107,27 @@ pub fn sustained_pitch_of_pluck_hz(
     };
     voice.pluck(&pluck);
     let samples = (CALIBRATION_SECONDS * sample_rate_hz).round() as usize;
-    let signal: Vec<f64> = (0..samples)
+    (0..samples)
         .map(|_| f64::from(voice.next_sample()))
-        .collect();
-    sustained_pitch_hz(&signal, sample_rate_hz, nominal_hz)
+        .collect()
+}
+
+/// The jawari's brightness in a pluck's first [`CALIBRATION_SECONDS`]: the level above 2 kHz
+/// relative to the whole sound (to 20 kHz or 0.45 of the sample rate), dB, averaged over its
+/// attack (0–0.3 s) and its sustain (0.6–1.2 s), the windows of `examples/jawari_moves.rs`.
+pub fn brightness_db(signal: &[f64], sample_rate_hz: f64) -> f64 {
+    let top_hz = (0.45 * sample_rate_hz).min(20_000.0);
+    let level = |from_s: f64, to_s: f64| {
+        let start = (from_s * sample_rate_hz) as usize;
+        let length = ((to_s - from_s) * sample_rate_hz) as usize;
+        let frame = (length.next_power_of_two() / 2).max(2);
+        let spectrum = power_spectrum(signal, start, frame, frame);
+        let bin_hz = sample_rate_hz / frame as f64;
+        let high = band_power(&spectrum, bin_hz, 2000.0, top_hz);
+        let all = band_power(&spectrum, bin_hz, 20.0, top_hz);
+        10.0 * (high.max(f64::MIN_POSITIVE) / all.max(f64::MIN_POSITIVE)).log10()
+    };
+    0.5 * (level(0.0, 0.3) + level(0.6, 1.2))
 }
 
 /// The offset, cents, to add to `settings.fundamental_hz` before the voice's linearised tuning
@@ -124,6 +176,120 @@ pub fn as_played_offset_cents(
     }
 }
 
+/// A string's calibration as played: the cents added to its linearised tuning's target and the
+/// distance its thread is moved (towards the bridge's crest when positive), m.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AsPlayed {
+    pub offset_cents: f64,
+    pub thread_offset_m: f64,
+}
+
+/// The velocities a calibration checks: the soft end, midway and the firm end.
+fn check_velocities(velocities: [f64; 2]) -> [f64; 3] {
+    [
+        velocities[0],
+        0.5 * (velocities[0] + velocities[1]),
+        velocities[1],
+    ]
+}
+
+/// How a string tuned with `offset_cents` sounds at `velocities`: the largest distance of the
+/// sustained pitches from the note, cents, and the brightness averaged over the soft and firm
+/// ends ([`brightness_db`]).
+fn check(
+    voice: &mut TanpuraVoice,
+    nominal_hz: f64,
+    offset_cents: f64,
+    pluck: &Pluck,
+    velocities: [f64; 3],
+    sample_rate_hz: f64,
+) -> (f64, f64) {
+    let target = nominal_hz * (offset_cents / 1200.0).exp2();
+    let mut worst: f64 = 0.0;
+    let mut brightness = 0.0;
+    for (index, &velocity) in velocities.iter().enumerate() {
+        let signal = render_pluck(voice, target, pluck, velocity, sample_rate_hz);
+        let pitch = sustained_pitch_hz(&signal, sample_rate_hz, nominal_hz);
+        let off = 1200.0 * (pitch / nominal_hz).log2();
+        // A pitch that cannot be measured is as far from settled as can be.
+        worst = worst.max(if off.is_finite() {
+            off.abs()
+        } else {
+            f64::INFINITY
+        });
+        if index != 1 {
+            brightness += 0.5 * brightness_db(&signal, sample_rate_hz);
+        }
+    }
+    (worst, brightness)
+}
+
+/// The calibration of a string as a player sets it (module doc): the offset that centres its
+/// soft and firm plucks on the note ([`as_played_offset_cents`]) and, where that leaves a pluck
+/// between them more than [`SETTLED_CENTS`] off, the smallest thread move of at most
+/// ±[`THREAD_STEPS`] × [`THREAD_STEP_M`] that settles it while keeping its brightness within
+/// [`BRIGHTNESS_KEPT_DB`]. Allocates and renders: off the audio thread.
+pub fn as_played_calibration(
+    settings: &VoiceSettings,
+    pluck: &Pluck,
+    velocities: [f64; 2],
+    sample_rate_hz: f64,
+) -> AsPlayed {
+    let settings = settings.clamped();
+    let unmoved = AsPlayed {
+        offset_cents: as_played_offset_cents(&settings, pluck, velocities, sample_rate_hz),
+        thread_offset_m: 0.0,
+    };
+    // A string played at one strength is centred exactly.
+    if velocities[0] == velocities[1] {
+        return unmoved;
+    }
+    let nominal = settings.fundamental_hz;
+    let checked = check_velocities(velocities);
+    let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
+    let (worst, brightness) = check(
+        &mut voice,
+        nominal,
+        unmoved.offset_cents,
+        pluck,
+        checked,
+        sample_rate_hz,
+    );
+    if worst <= SETTLED_CENTS || !brightness.is_finite() {
+        return unmoved;
+    }
+    for step in 1..=THREAD_STEPS {
+        for direction in [1.0, -1.0] {
+            let thread_offset_m = direction * step as f64 * THREAD_STEP_M;
+            let moved = VoiceSettings {
+                thread_position_m: settings.thread_position_m + thread_offset_m,
+                ..settings
+            }
+            .clamped();
+            if moved.thread_position_m == settings.thread_position_m {
+                continue;
+            }
+            let offset_cents = as_played_offset_cents(&moved, pluck, velocities, sample_rate_hz);
+            voice.set_settings(&moved);
+            let (worst, moved_brightness) = check(
+                &mut voice,
+                nominal,
+                offset_cents,
+                pluck,
+                checked,
+                sample_rate_hz,
+            );
+            if worst <= SETTLED_CENTS && moved_brightness >= brightness - BRIGHTNESS_KEPT_DB {
+                return AsPlayed {
+                    offset_cents,
+                    thread_offset_m: moved.thread_position_m - settings.thread_position_m,
+                };
+            }
+        }
+    }
+    unmoved
+}
+
 /// What to calibrate: a string, the pluck it is played with at full velocity, and the soft and
 /// firm ends of its velocities (fractions of full).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -143,8 +309,10 @@ pub const AS_PLAYED_CAPACITY: usize = 48;
 pub struct Calibration {
     pub request: CalibrationRequest,
     pub sample_rate_hz: f64,
-    /// Cents added to the linearisation's target ([`as_played_offset_cents`]).
+    /// Cents added to the linearisation's target ([`as_played_calibration`]).
     pub offset_cents: f64,
+    /// Distance the string's thread is moved, m ([`as_played_calibration`]).
+    pub thread_offset_m: f64,
 }
 
 impl Calibration {
@@ -161,15 +329,17 @@ impl Calibration {
                 }
             }),
         };
+        let as_played = as_played_calibration(
+            &request.settings,
+            &request.pluck,
+            request.velocities,
+            sample_rate_hz,
+        );
         Self {
             request,
             sample_rate_hz,
-            offset_cents: as_played_offset_cents(
-                &request.settings,
-                &request.pluck,
-                request.velocities,
-                sample_rate_hz,
-            ),
+            offset_cents: as_played.offset_cents,
+            thread_offset_m: as_played.thread_offset_m,
         }
     }
 
@@ -241,6 +411,15 @@ impl AsPlayedTuning {
             .map_or(0.0, |entry| entry.offset_cents)
     }
 
+    /// The thread move, m, for a string of `settings` (its note and tier); 0 without one.
+    pub fn thread_offset_m(&self, settings: &VoiceSettings) -> f64 {
+        self.entries
+            .iter()
+            .flatten()
+            .find(|entry| same_string(&entry.request.settings, settings))
+            .map_or(0.0, |entry| entry.thread_offset_m)
+    }
+
     /// True when the table holds a calibration measured for this request.
     pub fn is_current(&self, request: &CalibrationRequest, sample_rate_hz: f64) -> bool {
         self.entries
@@ -249,8 +428,9 @@ impl AsPlayedTuning {
             .any(|entry| entry.is_for(request, sample_rate_hz))
     }
 
-    /// Adds a calibration (its offset clamped to ±[`MAX_OFFSET_CENTS`], a non-finite one
-    /// ignored), replacing the one of the same note and tier, else a free entry, else the
+    /// Adds a calibration (its offset clamped to ±[`MAX_OFFSET_CENTS`] and its thread move to
+    /// ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], one with a non-finite offset ignored, a non-finite
+    /// thread move taken as none), replacing the one of the same note and tier, else a free entry, else the
     /// oldest. Allocation-free.
     pub fn insert(&mut self, mut calibration: Calibration) {
         if !calibration.offset_cents.is_finite() {
@@ -260,6 +440,14 @@ impl AsPlayedTuning {
         calibration.offset_cents = calibration
             .offset_cents
             .clamp(-MAX_OFFSET_CENTS, MAX_OFFSET_CENTS);
+        let largest_move_m = THREAD_STEPS as f64 * THREAD_STEP_M;
+        calibration.thread_offset_m = if calibration.thread_offset_m.is_finite() {
+            calibration
+                .thread_offset_m
+                .clamp(-largest_move_m, largest_move_m)
+        } else {
+            0.0
+        };
         let slot = self
             .entries
             .iter()
