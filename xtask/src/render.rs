@@ -616,9 +616,24 @@ fn calibrate(
         .iter()
         .map(|calibration| calibration.offset_cents.abs())
         .fold(0.0, f64::max);
+    let moved: Vec<f64> = calibrations
+        .iter()
+        .map(|calibration| calibration.thread_offset_m)
+        .filter(|&offset| offset != 0.0)
+        .collect();
+    let threads = if moved.is_empty() {
+        String::new()
+    } else {
+        let largest_move_mm = moved.iter().fold(0.0f64, |a, b| a.max(b.abs())) * 1e3;
+        format!(
+            "; the jawari set on {} string{} by moving its thread at most {largest_move_mm:.2} mm",
+            moved.len(),
+            if moved.len() == 1 { "" } else { "s" }
+        )
+    };
     eprintln!(
         "tuned {} string{} by their sustained pitch as played in {:.1} s (largest offset from \
-         the linearised tuning {largest:.1} cents)",
+         the linearised tuning {largest:.1} cents{threads})",
         calibrations.len(),
         if calibrations.len() == 1 { "" } else { "s" },
         started.elapsed().as_secs_f64()
