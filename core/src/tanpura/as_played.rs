@@ -27,22 +27,35 @@
 //! sound 10 cents apart (a soft pluck stays on the crest, a firm one lifts it off), and centring
 //! them is all a tension can do. A player then moves the string's thread until the note speaks
 //! the same at every strength, keeping the jawari's brightness, and so does the calibration
-//! ([`as_played_calibration`]). After centring, it checks the sustained pitch at the soft end,
-//! midway and the firm end of the string's velocities; if one lies more than [`SETTLED_CENTS`]
-//! from the note, it tries thread moves of [`THREAD_STEP_M`], ±1 to ±[`THREAD_STEPS`] steps
-//! (towards the crest first at each size), centres each again, and keeps the smallest that
-//! puts all three within [`SETTLED_CENTS`] and keeps the string's level above 2 kHz within
-//! [`BRIGHTNESS_KEPT_DB`] of the unmoved string's ([`brightness_db`]); without one the thread
-//! stays where the player put it. The window of thread positions over which a string is bistable
-//! is about 0.15 mm wide and moves by about 0.05 mm a semitone, so moves of 0.05–0.3 mm settle
-//! these notes; a millimetre would also settle them but takes 6–13 dB off their level above
-//! 2 kHz (`examples/jawari_moves.rs`, README).
+//! ([`as_played_calibration`]). Its second centring pass also plucks the string midway between
+//! the soft and firm ends. If those three sustained pitches lie more than
+//! [`UNSETTLED_SPREAD_CENTS`] apart (centred, one would lie more than 2 cents off), it tries
+//! thread moves of 1 to [`THREAD_STEPS`] steps of [`THREAD_STEP_M`] towards the crest, then away
+//! from it, and keeps the first that settles the string:
 //!
-//! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, the check three
-//! more, and each thread move tried a centring and a check again, so a calibration is an
-//! offline job (the renderer before it renders, a background thread in the plugin), never the
-//! audio thread's. The result is a plain number of cents and a thread move per string, which the
-//! engine adds to the string's target and thread position ([`AsPlayedTuning`]).
+//! - three plucks at the unmoved string's tuning lie within twice [`SETTLED_CENTS`] of each
+//!   other (what a tension can then centre), and keep the level above 2 kHz within
+//!   [`BRIGHTNESS_KEPT_DB`] of the unmoved string's ([`brightness_db`]);
+//! - after one more centring pass all three lie within [`SETTLED_CENTS`] of the note, with the
+//!   brightness still kept.
+//!
+//! Without one the thread stays where the player put it. Towards the crest first, because there
+//! every pluck above the soft end lifts the string off the crest onto the grazing contact the
+//! jawari's buzz comes from. A sweep of ±0.05, ±0.1 and ±0.2 mm over the reference tier's keys
+//! 51–52 and the studio tier's 52–53 (the strings not settled unmoved): the smallest move towards
+//! the crest that settled each changed its brightness by +0.0 to +0.8 dB, the smallest away from
+//! it, which presses the string onto the crest so that no pluck lifts it, by −2.8 to −5.9 dB.
+//! The window of thread positions over which a string is bistable is about 0.15 mm wide and moves
+//! by about 0.05 mm a semitone, so moves of 0.05–0.3 mm settle these notes; a millimetre would
+//! also settle them but takes 6–13 dB off their level above 2 kHz (`examples/jawari_moves.rs`,
+//! README).
+//!
+//! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier (the second
+//! three, with the midway pluck), each thread move tried three more and the one kept three more
+//! again, so a calibration is an offline job (the renderer before it renders, a background
+//! thread in the plugin), never the audio thread's. The result is a plain number of cents and a
+//! thread move per string, which the engine adds to the string's target and thread position
+//! ([`AsPlayedTuning`]).
 
 use super::excitation::Pluck;
 use super::voice::{TanpuraVoice, VoiceSettings};
@@ -63,7 +76,11 @@ pub const MAX_OFFSET_CENTS: f64 = 50.0;
 /// velocities lies within this of the note, cents (below the 2 cents a player hears as out of
 /// tune, for the velocities between those three).
 pub const SETTLED_CENTS: f64 = 1.5;
-/// The thread moves a calibration tries on a string that is not settled: multiples of this, m.
+/// A string is unsettled when the sustained pitches of its soft, midway and firm plucks lie
+/// more than this apart, cents: centred, one of them would lie more than 2 cents off the note,
+/// which a player hears as out of tune.
+pub const UNSETTLED_SPREAD_CENTS: f64 = 4.0;
+/// The thread moves a calibration tries on an unsettled string: multiples of this, m.
 pub const THREAD_STEP_M: f64 = 0.05e-3;
 /// The largest move tried, in steps (±0.3 mm).
 pub const THREAD_STEPS: usize = 6;
@@ -141,38 +158,45 @@ pub fn as_played_offset_cents(
     sample_rate_hz: f64,
 ) -> f64 {
     let settings = settings.clamped();
-    let nominal = settings.fundamental_hz;
     let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
-    // One render when both ends are the same strength.
-    let ends = if velocities[0] == velocities[1] { 1 } else { 2 };
     let mut offset = 0.0;
     for _ in 0..CALIBRATION_PASSES {
-        let target = nominal * (offset / 1200.0f64).exp2();
-        let log_mean = velocities[..ends]
-            .iter()
-            .map(|&velocity| {
-                sustained_pitch_of_pluck_hz(
-                    &mut voice,
-                    target,
-                    nominal,
-                    pluck,
-                    velocity,
-                    sample_rate_hz,
-                )
-                .log2()
-            })
-            .sum::<f64>()
-            / ends as f64;
-        let correction = 1200.0 * (nominal.log2() - log_mean);
-        if !correction.is_finite() {
-            return 0.0;
-        }
-        offset += correction;
+        offset += centring_pass(&mut voice, offset, pluck, velocities, sample_rate_hz);
     }
-    if offset.abs() > MAX_OFFSET_CENTS {
-        0.0
+    within_reach(offset)
+}
+
+/// One pass of the offset correction for the string of `voice` tuned with `offset_cents`: the
+/// change of offset that centres the sustained pitches of its soft and firm ends on its note,
+/// cents (non-finite if a pitch was not found). One render when both ends are the same strength.
+fn centring_pass(
+    voice: &mut TanpuraVoice,
+    offset_cents: f64,
+    pluck: &Pluck,
+    velocities: [f64; 2],
+    sample_rate_hz: f64,
+) -> f64 {
+    let nominal = voice.settings().fundamental_hz;
+    let target = nominal * (offset_cents / 1200.0f64).exp2();
+    let ends = if velocities[0] == velocities[1] { 1 } else { 2 };
+    let log_mean = velocities[..ends]
+        .iter()
+        .map(|&velocity| {
+            sustained_pitch_of_pluck_hz(voice, target, nominal, pluck, velocity, sample_rate_hz)
+                .log2()
+        })
+        .sum::<f64>()
+        / ends as f64;
+    1200.0 * (nominal.log2() - log_mean)
+}
+
+/// `offset_cents`, or 0 where it is not finite or beyond [`MAX_OFFSET_CENTS`] (a string that
+/// rings too short to be measured).
+fn within_reach(offset_cents: f64) -> f64 {
+    if offset_cents.abs() <= MAX_OFFSET_CENTS {
+        offset_cents
     } else {
-        offset
+        0.0
     }
 }
 
@@ -193,9 +217,48 @@ fn check_velocities(velocities: [f64; 2]) -> [f64; 3] {
     ]
 }
 
-/// How a string tuned with `offset_cents` sounds at `velocities`: the largest distance of the
-/// sustained pitches from the note, cents, and the brightness averaged over the soft and firm
-/// ends ([`brightness_db`]).
+/// How a string sounds at the soft end, midway and the firm end of its velocities.
+#[derive(Debug, Clone, Copy)]
+struct Checked {
+    /// Each pluck's sustained pitch, cents from the note (non-finite where none was found).
+    cents: [f64; 3],
+    /// [`brightness_db`] averaged over the soft and firm ends.
+    brightness_db: f64,
+}
+
+impl Checked {
+    /// The largest distance from the note, cents (infinite if a pitch was not found).
+    fn worst(&self) -> f64 {
+        self.cents.iter().fold(0.0, |worst: f64, &off| {
+            worst.max(if off.is_finite() {
+                off.abs()
+            } else {
+                f64::INFINITY
+            })
+        })
+    }
+
+    /// The largest distance between two of the plucks, cents (infinite if one was not found):
+    /// what no tension can take away.
+    fn spread(&self) -> f64 {
+        let high = self.cents.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+        let low = self.cents.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+        let spread = high - low;
+        if spread.is_finite() {
+            spread
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The change of offset that centres the soft and firm ends on the note, cents (one pass of
+    /// [`as_played_offset_cents`]).
+    fn centring_cents(&self) -> f64 {
+        -0.5 * (self.cents[0] + self.cents[2])
+    }
+}
+
+/// Renders the string of `voice` tuned with `offset_cents` at `velocities` and measures it.
 fn check(
     voice: &mut TanpuraVoice,
     nominal_hz: f64,
@@ -203,32 +266,28 @@ fn check(
     pluck: &Pluck,
     velocities: [f64; 3],
     sample_rate_hz: f64,
-) -> (f64, f64) {
+) -> Checked {
     let target = nominal_hz * (offset_cents / 1200.0).exp2();
-    let mut worst: f64 = 0.0;
-    let mut brightness = 0.0;
+    let mut checked = Checked {
+        cents: [0.0; 3],
+        brightness_db: 0.0,
+    };
     for (index, &velocity) in velocities.iter().enumerate() {
         let signal = render_pluck(voice, target, pluck, velocity, sample_rate_hz);
         let pitch = sustained_pitch_hz(&signal, sample_rate_hz, nominal_hz);
-        let off = 1200.0 * (pitch / nominal_hz).log2();
-        // A pitch that cannot be measured is as far from settled as can be.
-        worst = worst.max(if off.is_finite() {
-            off.abs()
-        } else {
-            f64::INFINITY
-        });
+        checked.cents[index] = 1200.0 * (pitch / nominal_hz).log2();
         if index != 1 {
-            brightness += 0.5 * brightness_db(&signal, sample_rate_hz);
+            checked.brightness_db += 0.5 * brightness_db(&signal, sample_rate_hz);
         }
     }
-    (worst, brightness)
+    checked
 }
 
 /// The calibration of a string as a player sets it (module doc): the offset that centres its
-/// soft and firm plucks on the note ([`as_played_offset_cents`]) and, where that leaves a pluck
-/// between them more than [`SETTLED_CENTS`] off, the smallest thread move of at most
-/// ±[`THREAD_STEPS`] × [`THREAD_STEP_M`] that settles it while keeping its brightness within
-/// [`BRIGHTNESS_KEPT_DB`]. Allocates and renders: off the audio thread.
+/// soft and firm plucks on the note ([`as_played_offset_cents`]) and, where the plucks it checks
+/// lie more than [`UNSETTLED_SPREAD_CENTS`] apart, the smallest thread move of at most
+/// ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], towards the crest first, that settles it while keeping
+/// its brightness within [`BRIGHTNESS_KEPT_DB`]. Allocates and renders: off the audio thread.
 pub fn as_played_calibration(
     settings: &VoiceSettings,
     pluck: &Pluck,
@@ -236,42 +295,71 @@ pub fn as_played_calibration(
     sample_rate_hz: f64,
 ) -> AsPlayed {
     let settings = settings.clamped();
-    let unmoved = AsPlayed {
-        offset_cents: as_played_offset_cents(&settings, pluck, velocities, sample_rate_hz),
-        thread_offset_m: 0.0,
-    };
     // A string played at one strength is centred exactly.
     if velocities[0] == velocities[1] {
-        return unmoved;
+        return AsPlayed {
+            offset_cents: as_played_offset_cents(&settings, pluck, velocities, sample_rate_hz),
+            thread_offset_m: 0.0,
+        };
     }
     let nominal = settings.fundamental_hz;
     let checked = check_velocities(velocities);
     let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
-    let (worst, brightness) = check(
+    // The first pass of [`as_played_offset_cents`], then its second with the midway pluck added:
+    // the same offset, and what is left that no tension can take away.
+    let first_offset = centring_pass(&mut voice, 0.0, pluck, velocities, sample_rate_hz);
+    let first = check(
         &mut voice,
         nominal,
-        unmoved.offset_cents,
+        first_offset,
         pluck,
         checked,
         sample_rate_hz,
     );
-    if worst <= SETTLED_CENTS || !brightness.is_finite() {
+    let offset_cents = first_offset + first.centring_cents();
+    let unmoved = AsPlayed {
+        offset_cents: within_reach(offset_cents),
+        thread_offset_m: 0.0,
+    };
+    if !offset_cents.is_finite()
+        || first.spread() <= UNSETTLED_SPREAD_CENTS
+        || !first.brightness_db.is_finite()
+    {
         return unmoved;
     }
-    for step in 1..=THREAD_STEPS {
-        for direction in [1.0, -1.0] {
-            let thread_offset_m = direction * step as f64 * THREAD_STEP_M;
+    let darkest_kept_db = first.brightness_db - BRIGHTNESS_KEPT_DB;
+    for direction in [1.0, -1.0] {
+        for step in 1..=THREAD_STEPS {
             let moved = VoiceSettings {
-                thread_position_m: settings.thread_position_m + thread_offset_m,
+                thread_position_m: settings.thread_position_m
+                    + direction * step as f64 * THREAD_STEP_M,
                 ..settings
             }
             .clamped();
             if moved.thread_position_m == settings.thread_position_m {
                 continue;
             }
-            let offset_cents = as_played_offset_cents(&moved, pluck, velocities, sample_rate_hz);
             voice.set_settings(&moved);
-            let (worst, moved_brightness) = check(
+            // Three plucks at the unmoved string's tuning tell whether a tension can settle the
+            // moved one, and whether it keeps its brightness.
+            let screened = check(
+                &mut voice,
+                nominal,
+                unmoved.offset_cents,
+                pluck,
+                checked,
+                sample_rate_hz,
+            );
+            if screened.spread() > 2.0 * SETTLED_CENTS
+                || !(screened.brightness_db >= darkest_kept_db)
+            {
+                continue;
+            }
+            let offset_cents = unmoved.offset_cents + screened.centring_cents();
+            if !(offset_cents.abs() <= MAX_OFFSET_CENTS) {
+                continue;
+            }
+            let verified = check(
                 &mut voice,
                 nominal,
                 offset_cents,
@@ -279,7 +367,7 @@ pub fn as_played_calibration(
                 checked,
                 sample_rate_hz,
             );
-            if worst <= SETTLED_CENTS && moved_brightness >= brightness - BRIGHTNESS_KEPT_DB {
+            if verified.worst() <= SETTLED_CENTS && verified.brightness_db >= darkest_kept_db {
                 return AsPlayed {
                     offset_cents,
                     thread_offset_m: moved.thread_position_m - settings.thread_position_m,
