@@ -3,9 +3,9 @@
 //! with the thread at several positions, on one tier:
 //! `cargo run --release -p javari-core --example jawari_moves -- TIER KEY VELOCITY MM…`
 //! (defaults: studio, key 51, velocity 80, threads 39, 40 and 41 mm). It measures why the
-//! as-played tuning (`tanpura/as_played.rs`) does not move a string's thread to settle a note
-//! whose pitch depends on how hard it is plucked: those strings sit at the jawari's sweet spot,
-//! and a millimetre either way that settles their pitch also takes most of their brightness.
+//! as-played tuning (`tanpura/as_played.rs`) settles a note whose pitch depends on how hard it
+//! is plucked by moving its thread a fraction of a millimetre and no further: those strings sit
+//! at the jawari's sweet spot, and a millimetre either way also takes most of their brightness.
 
 use javari_core::analysis::listening::centroid_course_hz;
 use javari_core::analysis::{band_power, power_spectrum};
@@ -73,7 +73,7 @@ fn main() {
             10.0 * (high / all).log10()
         };
         println!(
-            "thread {thread_mm:>5.1} mm: {:>6.0} {:>6.0} {:>6.0} {:>6.0} Hz | {:>6.1} {:>6.1} dB",
+            "thread {thread_mm:>5.2} mm: {:>6.0} {:>6.0} {:>6.0} {:>6.0} Hz | {:>6.1} {:>6.1} dB",
             at(0.1),
             at(0.3),
             at(0.6),

@@ -27,17 +27,16 @@
 //! sound 10 cents apart (a soft pluck stays on the crest, a firm one lifts it off), and centring
 //! them is all a tension can do. A player then moves the string's thread until the note speaks
 //! the same at every strength, keeping the jawari's brightness, and so does the calibration
-//! ([`as_played_calibration`]). Its second centring pass also plucks the string midway between
-//! the soft and firm ends. If those three sustained pitches lie more than
-//! [`UNSETTLED_SPREAD_CENTS`] apart (centred, one would lie more than 2 cents off), it tries
-//! thread moves of 1 to [`THREAD_STEPS`] steps of [`THREAD_STEP_M`] towards the crest, then away
-//! from it, and keeps the first that settles the string:
+//! ([`as_played_calibration`]). If the soft and firm ends still lie more than
+//! [`UNSETTLED_SPREAD_CENTS`] apart at the second centring pass (centred, each would lie more
+//! than 2 cents off), it tries thread moves of 1 to [`THREAD_STEPS`] steps of [`THREAD_STEP_M`]
+//! towards the crest, then away from it, and keeps the first that settles the string:
 //!
-//! - three plucks at the unmoved string's tuning lie within twice [`SETTLED_CENTS`] of each
+//! - the two ends at the unmoved string's tuning lie within twice [`SETTLED_CENTS`] of each
 //!   other (what a tension can then centre), and keep the level above 2 kHz within
 //!   [`BRIGHTNESS_KEPT_DB`] of the unmoved string's ([`brightness_db`]);
-//! - after one more centring pass all three lie within [`SETTLED_CENTS`] of the note, with the
-//!   brightness still kept.
+//! - after one more centring pass the soft end, a pluck midway and the firm end lie within
+//!   [`SETTLED_CENTS`] of the note, with the brightness still kept.
 //!
 //! Without one the thread stays where the player put it. Towards the crest first, because there
 //! every pluck above the soft end lifts the string off the crest onto the grazing contact the
@@ -50,9 +49,8 @@
 //! also settle them but takes 6–13 dB off their level above 2 kHz (`examples/jawari_moves.rs`,
 //! README).
 //!
-//! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier (the second
-//! three, with the midway pluck), each thread move tried three more and the one kept three more
-//! again, so a calibration is an offline job (the renderer before it renders, a background
+//! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, each thread move
+//! tried two more and the one kept three more again, so a calibration is an offline job (the renderer before it renders, a background
 //! thread in the plugin), never the audio thread's. The result is a plain number of cents and a
 //! thread move per string, which the engine adds to the string's target and thread position
 //! ([`AsPlayedTuning`]).
@@ -76,9 +74,9 @@ pub const MAX_OFFSET_CENTS: f64 = 50.0;
 /// velocities lies within this of the note, cents (below the 2 cents a player hears as out of
 /// tune, for the velocities between those three).
 pub const SETTLED_CENTS: f64 = 1.5;
-/// A string is unsettled when the sustained pitches of its soft, midway and firm plucks lie
-/// more than this apart, cents: centred, one of them would lie more than 2 cents off the note,
-/// which a player hears as out of tune.
+/// A string is unsettled when the sustained pitches of its soft and firm plucks lie more than
+/// this apart, cents: centred, each would lie more than 2 cents off the note, which a player
+/// hears as out of tune.
 pub const UNSETTLED_SPREAD_CENTS: f64 = 4.0;
 /// The thread moves a calibration tries on an unsettled string: multiples of this, m.
 pub const THREAD_STEP_M: f64 = 0.05e-3;
@@ -208,7 +206,7 @@ pub struct AsPlayed {
     pub thread_offset_m: f64,
 }
 
-/// The velocities a calibration checks: the soft end, midway and the firm end.
+/// The velocities a calibration checks a moved thread at: the soft end, midway and the firm end.
 fn check_velocities(velocities: [f64; 2]) -> [f64; 3] {
     [
         velocities[0],
@@ -217,16 +215,16 @@ fn check_velocities(velocities: [f64; 2]) -> [f64; 3] {
     ]
 }
 
-/// How a string sounds at the soft end, midway and the firm end of its velocities.
+/// How a string sounds at `N` velocities, the soft end first and the firm end last.
 #[derive(Debug, Clone, Copy)]
-struct Checked {
+struct Checked<const N: usize> {
     /// Each pluck's sustained pitch, cents from the note (non-finite where none was found).
-    cents: [f64; 3],
+    cents: [f64; N],
     /// [`brightness_db`] averaged over the soft and firm ends.
     brightness_db: f64,
 }
 
-impl Checked {
+impl<const N: usize> Checked<N> {
     /// The largest distance from the note, cents (infinite if a pitch was not found).
     fn worst(&self) -> f64 {
         self.cents.iter().fold(0.0, |worst: f64, &off| {
@@ -254,29 +252,29 @@ impl Checked {
     /// The change of offset that centres the soft and firm ends on the note, cents (one pass of
     /// [`as_played_offset_cents`]).
     fn centring_cents(&self) -> f64 {
-        -0.5 * (self.cents[0] + self.cents[2])
+        -0.5 * (self.cents[0] + self.cents[N - 1])
     }
 }
 
 /// Renders the string of `voice` tuned with `offset_cents` at `velocities` and measures it.
-fn check(
+fn check<const N: usize>(
     voice: &mut TanpuraVoice,
-    nominal_hz: f64,
     offset_cents: f64,
     pluck: &Pluck,
-    velocities: [f64; 3],
+    velocities: [f64; N],
     sample_rate_hz: f64,
-) -> Checked {
-    let target = nominal_hz * (offset_cents / 1200.0).exp2();
+) -> Checked<N> {
+    let nominal = voice.settings().fundamental_hz;
+    let target = nominal * (offset_cents / 1200.0).exp2();
     let mut checked = Checked {
-        cents: [0.0; 3],
+        cents: [0.0; N],
         brightness_db: 0.0,
     };
     for (index, &velocity) in velocities.iter().enumerate() {
         let signal = render_pluck(voice, target, pluck, velocity, sample_rate_hz);
-        let pitch = sustained_pitch_hz(&signal, sample_rate_hz, nominal_hz);
-        checked.cents[index] = 1200.0 * (pitch / nominal_hz).log2();
-        if index != 1 {
+        let pitch = sustained_pitch_hz(&signal, sample_rate_hz, nominal);
+        checked.cents[index] = 1200.0 * (pitch / nominal).log2();
+        if index == 0 || index == N - 1 {
             checked.brightness_db += 0.5 * brightness_db(&signal, sample_rate_hz);
         }
     }
@@ -284,10 +282,11 @@ fn check(
 }
 
 /// The calibration of a string as a player sets it (module doc): the offset that centres its
-/// soft and firm plucks on the note ([`as_played_offset_cents`]) and, where the plucks it checks
-/// lie more than [`UNSETTLED_SPREAD_CENTS`] apart, the smallest thread move of at most
-/// ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], towards the crest first, that settles it while keeping
-/// its brightness within [`BRIGHTNESS_KEPT_DB`]. Allocates and renders: off the audio thread.
+/// soft and firm plucks on the note ([`as_played_offset_cents`]) and, where the two lie more
+/// than [`UNSETTLED_SPREAD_CENTS`] apart at the second pass, the smallest thread move of at
+/// most ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], towards the crest first, that settles the soft,
+/// midway and firm plucks while keeping the brightness within [`BRIGHTNESS_KEPT_DB`].
+/// Allocates and renders: off the audio thread.
 pub fn as_played_calibration(
     settings: &VoiceSettings,
     pluck: &Pluck,
@@ -302,32 +301,23 @@ pub fn as_played_calibration(
             thread_offset_m: 0.0,
         };
     }
-    let nominal = settings.fundamental_hz;
-    let checked = check_velocities(velocities);
     let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
-    // The first pass of [`as_played_offset_cents`], then its second with the midway pluck added:
-    // the same offset, and what is left that no tension can take away.
+    // The two passes of [`as_played_offset_cents`] (the same renders and the same offset), the
+    // second kept: what is left between the ends is what no tension can take away.
     let first_offset = centring_pass(&mut voice, 0.0, pluck, velocities, sample_rate_hz);
-    let first = check(
-        &mut voice,
-        nominal,
-        first_offset,
-        pluck,
-        checked,
-        sample_rate_hz,
-    );
-    let offset_cents = first_offset + first.centring_cents();
+    let second = check(&mut voice, first_offset, pluck, velocities, sample_rate_hz);
+    let offset_cents = first_offset + second.centring_cents();
     let unmoved = AsPlayed {
         offset_cents: within_reach(offset_cents),
         thread_offset_m: 0.0,
     };
     if !offset_cents.is_finite()
-        || first.spread() <= UNSETTLED_SPREAD_CENTS
-        || !first.brightness_db.is_finite()
+        || second.spread() <= UNSETTLED_SPREAD_CENTS
+        || !second.brightness_db.is_finite()
     {
         return unmoved;
     }
-    let darkest_kept_db = first.brightness_db - BRIGHTNESS_KEPT_DB;
+    let darkest_kept_db = second.brightness_db - BRIGHTNESS_KEPT_DB;
     for direction in [1.0, -1.0] {
         for step in 1..=THREAD_STEPS {
             let moved = VoiceSettings {
@@ -340,14 +330,13 @@ pub fn as_played_calibration(
                 continue;
             }
             voice.set_settings(&moved);
-            // Three plucks at the unmoved string's tuning tell whether a tension can settle the
+            // The two ends at the unmoved string's tuning tell whether a tension can settle the
             // moved one, and whether it keeps its brightness.
             let screened = check(
                 &mut voice,
-                nominal,
                 unmoved.offset_cents,
                 pluck,
-                checked,
+                velocities,
                 sample_rate_hz,
             );
             if screened.spread() > 2.0 * SETTLED_CENTS
@@ -361,10 +350,9 @@ pub fn as_played_calibration(
             }
             let verified = check(
                 &mut voice,
-                nominal,
                 offset_cents,
                 pluck,
-                checked,
+                check_velocities(velocities),
                 sample_rate_hz,
             );
             if verified.worst() <= SETTLED_CENTS && verified.brightness_db >= darkest_kept_db {
