@@ -340,12 +340,13 @@ pub fn as_played_calibration(
                 sample_rate_hz,
             );
             if screened.spread() > 2.0 * SETTLED_CENTS
-                || !(screened.brightness_db >= darkest_kept_db)
+                || screened.brightness_db.is_nan()
+                || screened.brightness_db < darkest_kept_db
             {
                 continue;
             }
             let offset_cents = unmoved.offset_cents + screened.centring_cents();
-            if !(offset_cents.abs() <= MAX_OFFSET_CENTS) {
+            if offset_cents.is_nan() || offset_cents.abs() > MAX_OFFSET_CENTS {
                 continue;
             }
             let verified = check(
