@@ -50,10 +50,10 @@
 //! README).
 //!
 //! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, each thread move
-//! tried two more and the one kept three more again, so a calibration is an offline job (the renderer before it renders, a background
-//! thread in the plugin), never the audio thread's. The result is a plain number of cents and a
-//! thread move per string, which the engine adds to the string's target and thread position
-//! ([`AsPlayedTuning`]).
+//! tried two more and the one kept three more again, so a calibration is an offline job (the
+//! renderer before it renders, a background thread in the plugin), never the audio thread's.
+//! The result is a plain number of cents and a thread move per string, which the engine adds to
+//! the string's target and thread position ([`AsPlayedTuning`]).
 
 use super::excitation::Pluck;
 use super::voice::{TanpuraVoice, VoiceSettings};
@@ -507,8 +507,8 @@ impl AsPlayedTuning {
 
     /// Adds a calibration (its offset clamped to ±[`MAX_OFFSET_CENTS`] and its thread move to
     /// ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], one with a non-finite offset ignored, a non-finite
-    /// thread move taken as none), replacing the one of the same note and tier, else a free entry, else the
-    /// oldest. Allocation-free.
+    /// thread move taken as none), replacing the one of the same note and tier, else a free
+    /// entry, else the oldest. Allocation-free.
     pub fn insert(&mut self, mut calibration: Calibration) {
         if !calibration.offset_cents.is_finite() {
             return;
