@@ -334,7 +334,9 @@ pub struct JavariParams {
     pub drone_sa_note: IntParam,
     #[nested(array, group = "Drone string")]
     pub drone_strings: [DroneStringParams; MAX_DRONE_STRINGS],
-    /// Tune each string by its sustained pitch as played (measured on a background thread).
+    /// Tune each string by its sustained pitch as played, and set the jawari (move its thread by
+    /// up to 0.3 mm) of one whose soft and firm plucks would not settle (measured on a background
+    /// thread; `javari_core::tanpura::as_played`).
     #[id = "asplay"]
     pub tune_as_played: BoolParam,
     #[id = "width"]

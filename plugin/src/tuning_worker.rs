@@ -124,5 +124,7 @@ mod tests {
         let calibration = engine.as_played_tuning().calibrations().next().unwrap();
         assert!((calibration.request.settings.fundamental_hz - 220.0).abs() < 1e-9);
         assert!(calibration.offset_cents.is_finite());
+        // A3 at the live tier settles without the jawari set.
+        assert_eq!(calibration.thread_offset_m, 0.0);
     }
 }
