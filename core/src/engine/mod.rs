@@ -1415,9 +1415,9 @@ impl Engine {
             if !self.as_played.is_current(&request, self.sample_rate_hz) {
                 self.want_calibration(&request);
             }
-            let offset = self.as_played.offset_cents(&string_settings);
-            thread_set_m = self.as_played.thread_offset_m(&string_settings);
-            string_settings.fundamental_hz *= (offset / 1200.0).exp2();
+            let as_played = self.as_played.as_played(&string_settings);
+            thread_set_m = as_played.thread_offset_m;
+            string_settings.fundamental_hz *= (as_played.offset_cents / 1200.0).exp2();
             string_settings.thread_position_m += thread_set_m;
             string_settings = string_settings.clamped();
         }

@@ -41,9 +41,11 @@
 //! Without one the thread stays where the player put it. Towards the crest first, because there
 //! every pluck above the soft end lifts the string off the crest onto the grazing contact the
 //! jawari's buzz comes from. A sweep of ±0.05, ±0.1 and ±0.2 mm over the reference tier's keys
-//! 51–52 and the studio tier's 52–53 (the strings not settled unmoved): the smallest move towards
-//! the crest that settled each changed its brightness by +0.0 to +0.8 dB, the smallest away from
-//! it, which presses the string onto the crest so that no pluck lifts it, by −2.8 to −5.9 dB.
+//! 51–52 and the studio tier's 52–53 (the strings not settled unmoved; a throwaway tool of stop
+//! 32, each move repeatable with `examples/jawari_moves.rs` and `examples/as_played.rs` with a
+//! thread position such as `40.1mm`): the smallest move towards the crest that settled each
+//! changed its brightness by +0.0 to +0.8 dB, the smallest away from it, which presses the
+//! string onto the crest so that no pluck lifts it, by −2.8 to −5.9 dB.
 //! The window of thread positions over which a string is bistable is about 0.15 mm wide and moves
 //! by about 0.05 mm a semitone, so moves of 0.05–0.3 mm settle these notes; a millimetre would
 //! also settle them but takes 6–13 dB off their level above 2 kHz (`examples/jawari_moves.rs`,
@@ -479,22 +481,17 @@ fn same_string(a: &VoiceSettings, b: &VoiceSettings) -> bool {
 }
 
 impl AsPlayedTuning {
-    /// The offset, cents, for a string of `settings` (its note and tier); 0 without one.
-    pub fn offset_cents(&self, settings: &VoiceSettings) -> f64 {
+    /// The offset and thread move for a string of `settings` (its note and tier); none without
+    /// a calibration. Allocation-free.
+    pub fn as_played(&self, settings: &VoiceSettings) -> AsPlayed {
         self.entries
             .iter()
             .flatten()
             .find(|entry| same_string(&entry.request.settings, settings))
-            .map_or(0.0, |entry| entry.offset_cents)
-    }
-
-    /// The thread move, m, for a string of `settings` (its note and tier); 0 without one.
-    pub fn thread_offset_m(&self, settings: &VoiceSettings) -> f64 {
-        self.entries
-            .iter()
-            .flatten()
-            .find(|entry| same_string(&entry.request.settings, settings))
-            .map_or(0.0, |entry| entry.thread_offset_m)
+            .map_or(AsPlayed::default(), |entry| AsPlayed {
+                offset_cents: entry.offset_cents,
+                thread_offset_m: entry.thread_offset_m,
+            })
     }
 
     /// True when the table holds a calibration measured for this request.
