@@ -2,7 +2,8 @@
 //! tier, with the linearised tuning alone and with the as-played calibration
 //! (`tanpura/as_played.rs`): `cargo run --release -p javari-core --example as_played -- TIER KEY…`
 //! (TIER: draft, live, studio or reference; keys default to 36–64; an argument such as `41mm`
-//! moves the thread from its 40 mm). One row per key: the calibration's offset (cents) and thread
+//! moves the thread from its 40 mm, one such as `pluck=0.20` plucks at 0.20 m from the bead
+//! instead of the default 0.35 m). One row per key: the calibration's offset (cents) and thread
 //! move (mm), then one column per MIDI velocity, cents from the key's pitch, with the linearised
 //! tuning and as played; each block's last column is the largest deviation at velocities 40–110.
 
@@ -20,7 +21,7 @@ use std::sync::Mutex;
 const SAMPLE_RATE: f64 = 44_100.0;
 const VELOCITIES: [u8; 6] = [1, 40, 60, 80, 110, 127];
 
-fn row(voice: &mut TanpuraVoice, key: u8, offset_cents: f64) -> (String, f64) {
+fn row(voice: &mut TanpuraVoice, pluck: &Pluck, key: u8, offset_cents: f64) -> (String, f64) {
     let nominal = note_to_hz(key);
     let mut text = String::new();
     let mut worst: f64 = 0.0;
@@ -29,7 +30,7 @@ fn row(voice: &mut TanpuraVoice, key: u8, offset_cents: f64) -> (String, f64) {
             voice,
             nominal * (offset_cents / 1200.0).exp2(),
             nominal,
-            &Pluck::default(),
+            pluck,
             f64::from(velocity) / 127.0,
             SAMPLE_RATE,
         );
@@ -57,6 +58,15 @@ fn main() {
         .iter()
         .find_map(|argument| argument.strip_suffix("mm")?.parse::<f64>().ok())
         .map_or(VoiceSettings::default().thread_position_m, |mm| mm / 1000.0);
+    let pluck = Pluck {
+        position_m: arguments
+            .iter()
+            .find_map(|argument| argument.strip_prefix("pluck=")?.parse::<f64>().ok())
+            .unwrap_or(Pluck::default().position_m),
+        ..Pluck::default()
+    }
+    .clamped();
+    let pluck = &pluck;
     if keys.is_empty() {
         keys = (36..=64).collect();
     }
@@ -72,19 +82,15 @@ fn main() {
                         thread_position_m,
                         ..VoiceSettings::default()
                     };
-                    let as_played = as_played_calibration(
-                        &settings,
-                        &Pluck::default(),
-                        NOTE_VELOCITIES,
-                        SAMPLE_RATE,
-                    );
+                    let as_played =
+                        as_played_calibration(&settings, pluck, NOTE_VELOCITIES, SAMPLE_RATE);
                     let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
-                    let linearised = row(&mut voice, key, 0.0);
+                    let linearised = row(&mut voice, pluck, key, 0.0);
                     voice.set_settings(&VoiceSettings {
                         thread_position_m: settings.thread_position_m + as_played.thread_offset_m,
                         ..settings
                     });
-                    let played = row(&mut voice, key, as_played.offset_cents);
+                    let played = row(&mut voice, pluck, key, as_played.offset_cents);
                     rows.lock().expect("a row thread panicked").push((
                         key,
                         as_played.offset_cents,
@@ -99,9 +105,11 @@ fn main() {
     let mut rows = rows.into_inner().expect("a row thread panicked");
     rows.sort_by_key(|row| row.0);
     println!(
-        "{} tier, thread at {:.1} mm, cents from the key's pitch at MIDI velocities {VELOCITIES:?}",
+        "{} tier, thread at {:.1} mm, plucked at {:.2} m, cents from the key's pitch at MIDI \
+         velocities {VELOCITIES:?}",
         quality.name(),
-        thread_position_m * 1000.0
+        thread_position_m * 1000.0,
+        pluck.position_m
     );
     println!("key  offset thread | linearised tuning                                | worst | as played                                        | worst");
     let (mut worst_linearised, mut worst_played): (f64, f64) = (0.0, 0.0);

@@ -161,22 +161,30 @@ pub fn as_played_offset_cents(
     let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
     let mut offset = 0.0;
     for _ in 0..CALIBRATION_PASSES {
-        offset += centring_pass(&mut voice, offset, pluck, velocities, sample_rate_hz);
+        offset += centring_pass(
+            &mut voice,
+            settings.fundamental_hz,
+            offset,
+            pluck,
+            velocities,
+            sample_rate_hz,
+        );
     }
     within_reach(offset)
 }
 
-/// One pass of the offset correction for the string of `voice` tuned with `offset_cents`: the
-/// change of offset that centres the sustained pitches of its soft and firm ends on its note,
-/// cents (non-finite if a pitch was not found). One render when both ends are the same strength.
+/// One pass of the offset correction for the string of `voice` tuned with `offset_cents` from
+/// its note `nominal` (as in [`check`]): the change of offset that centres the sustained pitches
+/// of its soft and firm ends on its note, cents (non-finite if a pitch was not found). One
+/// render when both ends are the same strength.
 fn centring_pass(
     voice: &mut TanpuraVoice,
+    nominal: f64,
     offset_cents: f64,
     pluck: &Pluck,
     velocities: [f64; 2],
     sample_rate_hz: f64,
 ) -> f64 {
-    let nominal = voice.settings().fundamental_hz;
     let target = nominal * (offset_cents / 1200.0f64).exp2();
     let ends = if velocities[0] == velocities[1] { 1 } else { 2 };
     let log_mean = velocities[..ends]
@@ -258,15 +266,17 @@ impl<const N: usize> Checked<N> {
     }
 }
 
-/// Renders the string of `voice` tuned with `offset_cents` at `velocities` and measures it.
+/// Renders the string of `voice` tuned with `offset_cents` from its note `nominal` at
+/// `velocities` and measures it. The note is passed in: a render leaves the voice's own settings
+/// at the last render's target, not at the note.
 fn check<const N: usize>(
     voice: &mut TanpuraVoice,
+    nominal: f64,
     offset_cents: f64,
     pluck: &Pluck,
     velocities: [f64; N],
     sample_rate_hz: f64,
 ) -> Checked<N> {
-    let nominal = voice.settings().fundamental_hz;
     let target = nominal * (offset_cents / 1200.0).exp2();
     let mut checked = Checked {
         cents: [0.0; N],
@@ -306,8 +316,22 @@ pub fn as_played_calibration(
     let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
     // The two passes of [`as_played_offset_cents`] (the same renders and the same offset), the
     // second kept: what is left between the ends is what no tension can take away.
-    let first_offset = centring_pass(&mut voice, 0.0, pluck, velocities, sample_rate_hz);
-    let second = check(&mut voice, first_offset, pluck, velocities, sample_rate_hz);
+    let first_offset = centring_pass(
+        &mut voice,
+        settings.fundamental_hz,
+        0.0,
+        pluck,
+        velocities,
+        sample_rate_hz,
+    );
+    let second = check(
+        &mut voice,
+        settings.fundamental_hz,
+        first_offset,
+        pluck,
+        velocities,
+        sample_rate_hz,
+    );
     let offset_cents = first_offset + second.centring_cents();
     let unmoved = AsPlayed {
         offset_cents: within_reach(offset_cents),
@@ -336,6 +360,7 @@ pub fn as_played_calibration(
             // moved one, and whether it keeps its brightness.
             let screened = check(
                 &mut voice,
+                settings.fundamental_hz,
                 unmoved.offset_cents,
                 pluck,
                 velocities,
@@ -353,6 +378,7 @@ pub fn as_played_calibration(
             }
             let verified = check(
                 &mut voice,
+                settings.fundamental_hz,
                 offset_cents,
                 pluck,
                 check_velocities(velocities),
@@ -549,5 +575,33 @@ impl AsPlayedTuning {
     /// The calibrations held.
     pub fn calibrations(&self) -> impl Iterator<Item = &Calibration> {
         self.entries.iter().flatten()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tanpura::quality::Quality;
+
+    /// Stop 32's calibration read the note from the voice's settings, which each render leaves at
+    /// its own target: the check of a moved thread then rendered the string tuned by the
+    /// unmoved offset on top of its own.
+    #[test]
+    fn a_check_tunes_from_the_note_whatever_the_voice_last_rendered() {
+        let settings = VoiceSettings {
+            quality: Quality::Draft,
+            ..VoiceSettings::default()
+        };
+        let nominal = settings.fundamental_hz;
+        let mut voice = TanpuraVoice::new(&settings, 44_100.0);
+        let pluck = Pluck::default();
+        check(&mut voice, nominal, 30.0, &pluck, [0.5], 44_100.0);
+        check(&mut voice, nominal, -3.0, &pluck, [0.5], 44_100.0);
+        let tuned = voice.settings().fundamental_hz;
+        let expected = nominal * (-3.0f64 / 1200.0).exp2();
+        assert!(
+            (tuned / expected - 1.0).abs() < 1e-12,
+            "tuned to {tuned} Hz, expected {expected} Hz"
+        );
     }
 }
