@@ -85,26 +85,51 @@ pub fn windowed_dft_power<T: Copy + Into<f64>>(
 }
 
 /// |DFT|² of an already windowed `signal` at `frequency_hz` (any frequency, not only a bin).
+///
+/// A rotating phasor instead of sin/cos per sample, renormalised every 1024 samples against
+/// drift. The signal is cut into [`DFT_CHAINS`] equal contiguous parts, each with its own phasor
+/// and sums, so that their multiply-add chains run side by side (the pitch searches of the
+/// calibration and the bench call this some hundred times per pluck); the few samples left over
+/// take sin/cos each.
 fn dft_power(windowed: &[f64], sample_rate_hz: f64, frequency_hz: f64) -> f64 {
     let omega = 2.0 * PI * frequency_hz / sample_rate_hz;
-    let (mut re, mut im) = (0.0, 0.0);
-    // Rotate a phasor instead of calling sin/cos per sample; renormalise to stop drift.
     let (step_sin, step_cos) = omega.sin_cos();
-    let (mut c, mut s) = (1.0f64, 0.0f64);
-    for (i, &x) in windowed.iter().enumerate() {
-        re += x * c;
-        im -= x * s;
-        let next_c = c * step_cos - s * step_sin;
-        s = s * step_cos + c * step_sin;
-        c = next_c;
-        if i % 1024 == 1023 {
-            let norm = (c * c + s * s).sqrt();
-            c /= norm;
-            s /= norm;
+    let part = windowed.len() / DFT_CHAINS;
+    let mut re = [0.0f64; DFT_CHAINS];
+    let mut im = [0.0f64; DFT_CHAINS];
+    let mut c = [0.0f64; DFT_CHAINS];
+    let mut s = [0.0f64; DFT_CHAINS];
+    for chain in 0..DFT_CHAINS {
+        (s[chain], c[chain]) = (omega * (chain * part) as f64).sin_cos();
+    }
+    for i in 0..part {
+        for chain in 0..DFT_CHAINS {
+            let x = windowed[chain * part + i];
+            re[chain] += x * c[chain];
+            im[chain] -= x * s[chain];
+            let next_c = c[chain] * step_cos - s[chain] * step_sin;
+            s[chain] = s[chain] * step_cos + c[chain] * step_sin;
+            c[chain] = next_c;
         }
+        if i % 1024 == 1023 {
+            for chain in 0..DFT_CHAINS {
+                let norm = (c[chain] * c[chain] + s[chain] * s[chain]).sqrt();
+                c[chain] /= norm;
+                s[chain] /= norm;
+            }
+        }
+    }
+    let (mut re, mut im): (f64, f64) = (re.iter().sum(), im.iter().sum());
+    for (i, &x) in windowed.iter().enumerate().skip(DFT_CHAINS * part) {
+        let (sin, cos) = (omega * i as f64).sin_cos();
+        re += x * cos;
+        im -= x * sin;
     }
     re * re + im * im
 }
+
+/// Independent phasor chains of [`dft_power`].
+const DFT_CHAINS: usize = 4;
 
 pub fn peak_frequency_hz(signal: &[f64], sample_rate_hz: f64, low_hz: f64, high_hz: f64) -> f64 {
     let duration = signal.len() as f64 / sample_rate_hz;
