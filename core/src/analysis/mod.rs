@@ -367,6 +367,31 @@ mod tests {
     }
 
     #[test]
+    fn the_chained_dft_power_is_the_direct_sum() {
+        // Lengths with every remainder after the four parts, long enough for the renormalisation.
+        for n in [3usize, 4, 4097, 10_001, 10_002, 10_003] {
+            let signal: Vec<f64> = (0..n)
+                .map(|i| (0.37 * i as f64).sin() + 0.5 * (1.91 * i as f64).cos())
+                .collect();
+            for frequency_hz in [0.0, 13.7, 617.3, 2_345.6] {
+                let omega = 2.0 * PI * frequency_hz / 8_000.0;
+                let (mut re, mut im) = (0.0, 0.0);
+                for (i, &x) in signal.iter().enumerate() {
+                    re += x * (omega * i as f64).cos();
+                    im -= x * (omega * i as f64).sin();
+                }
+                let direct = re * re + im * im;
+                let chained = dft_power(&signal, 8_000.0, frequency_hz);
+                let scale = signal.iter().map(|x| x * x).sum::<f64>() * n as f64;
+                assert!(
+                    (chained - direct).abs() <= 1e-10 * scale,
+                    "n {n}, {frequency_hz} Hz: {chained} against {direct}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn peak_frequency_is_found_to_a_millihertz() {
         let rate = 8000.0;
         let f = 187.1234;

@@ -16,15 +16,12 @@
 //! [`sustained_pitch_hz`]), and shifts the linearisation's target by the offset that centres
 //! them on `f₀`:
 //!
-//! `c ← c + 1200 log₂(f₀ / √(f_soft f_firm))` (cents), at most [`CALIBRATION_PASSES`] times,
+//! `c ← c + 1200 log₂(f₀ / √(f_soft f_firm))` (cents), [`CALIBRATION_PASSES`] times,
 //!
 //! starting from `c = 0`. Centring the geometric mean minimises the largest deviation of the two
 //! ends when the pitch changes monotonically with velocity between them. One pass is exact when
 //! the pitch scales with the target (`f ∝ √T` with the contact state unchanged); the second
-//! pass catches the contact state that the retuning itself moves. A first pass that moves the
-//! target by at most [`ONE_PASS_CENTS`] (most keys: the crest keys move by 2–12 cents) is the
-//! last: a second then changed the offset by at most 0.08 cents (`examples/calibration_passes.rs`,
-//! keys 36–64 at the reference and studio tiers), and it saves two renders per string.
+//! pass catches the contact state that the retuning itself moves.
 //!
 //! **Setting the jawari.** Where the string at rest just touches the crest the two ends can
 //! sound 10 cents apart (a soft pluck stays on the crest, a firm one lifts it off), and centring
@@ -68,12 +65,8 @@ use crate::analysis::{band_power, power_spectrum};
 /// The soft and firm ends of a played note's velocities (MIDI 40 and 110, as fractions of full),
 /// whose sustained pitches a note's calibration centres.
 pub const NOTE_VELOCITIES: [f64; 2] = [40.0 / 127.0, 110.0 / 127.0];
-/// Passes of the offset correction, at most.
+/// Passes of the offset correction.
 pub const CALIBRATION_PASSES: usize = 2;
-/// A pass that changes the offset by at most this, cents, is not followed by another: over keys
-/// 36–64 at the reference and studio tiers, a second pass after a first of at most 1 cent changed
-/// the offset by at most 0.08 cents (`examples/calibration_passes.rs`).
-pub const ONE_PASS_CENTS: f64 = 1.0;
 /// Length of each calibration render, s: to the end of the sustain window.
 pub const CALIBRATION_SECONDS: f64 = SUSTAIN_WINDOW_S.1;
 /// Largest offset a calibration may find, cents: beyond it the measurement is not a
@@ -168,7 +161,7 @@ pub fn as_played_offset_cents(
     let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
     let mut offset = 0.0;
     for _ in 0..CALIBRATION_PASSES {
-        let change = centring_pass(
+        offset += centring_pass(
             &mut voice,
             settings.fundamental_hz,
             offset,
@@ -176,10 +169,6 @@ pub fn as_played_offset_cents(
             velocities,
             sample_rate_hz,
         );
-        offset += change;
-        if change.abs() <= ONE_PASS_CENTS {
-            break;
-        }
     }
     within_reach(offset)
 }
@@ -327,7 +316,7 @@ pub fn as_played_calibration(
     let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
     // The two passes of [`as_played_offset_cents`] (the same renders and the same offset), the
     // second kept: what is left between the ends is what no tension can take away.
-    let first = check(
+    let first_offset = centring_pass(
         &mut voice,
         settings.fundamental_hz,
         0.0,
@@ -335,15 +324,6 @@ pub fn as_played_calibration(
         velocities,
         sample_rate_hz,
     );
-    let first_offset = first.centring_cents();
-    // A first pass that hardly moved the target leaves nothing for a second to correct, and its
-    // ends lie close enough together that no move is looked for.
-    if first_offset.abs() <= ONE_PASS_CENTS && first.spread() <= UNSETTLED_SPREAD_CENTS {
-        return AsPlayed {
-            offset_cents: first_offset,
-            thread_offset_m: 0.0,
-        };
-    }
     let second = check(
         &mut voice,
         settings.fundamental_hz,
