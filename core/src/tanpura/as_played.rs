@@ -185,17 +185,27 @@ fn centring_pass(
     velocities: [f64; 2],
     sample_rate_hz: f64,
 ) -> f64 {
-    let target = nominal * (offset_cents / 1200.0f64).exp2();
-    let ends = if velocities[0] == velocities[1] { 1 } else { 2 };
-    let log_mean = velocities[..ends]
-        .iter()
-        .map(|&velocity| {
-            sustained_pitch_of_pluck_hz(voice, target, nominal, pluck, velocity, sample_rate_hz)
-                .log2()
-        })
-        .sum::<f64>()
-        / ends as f64;
-    1200.0 * (nominal.log2() - log_mean)
+    if velocities[0] == velocities[1] {
+        check(
+            voice,
+            nominal,
+            offset_cents,
+            pluck,
+            [velocities[0]],
+            sample_rate_hz,
+        )
+        .centring_cents()
+    } else {
+        check(
+            voice,
+            nominal,
+            offset_cents,
+            pluck,
+            velocities,
+            sample_rate_hz,
+        )
+        .centring_cents()
+    }
 }
 
 /// `offset_cents`, or 0 where it is not finite or beyond [`MAX_OFFSET_CENTS`] (a string that
