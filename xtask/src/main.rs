@@ -6,6 +6,7 @@
 mod args;
 mod bench;
 mod bundle;
+mod calibration_cache;
 mod playing_range;
 mod plot;
 mod render;

@@ -11,13 +11,15 @@
 //!
 //! Every pluck is tuned as `cargo xtask render` tunes it, by its sustained pitch as played
 //! (`javari_core::tanpura::as_played`): each tier's string at each key and pluck position is
-//! calibrated on that tier first (the reference's calibrations are cached beside its renders).
+//! calibrated on that tier first (every calibration is kept for the next run, per version of
+//! `core/`: `crate::calibration_cache`).
 
+use crate::calibration_cache::{calibration, core_version, workspace, CalibrationCache};
 use javari_core::analysis::cents;
 use javari_core::analysis::listening::{compare, sustained_pitch_hz, ListeningDifference};
 use javari_core::analysis::playing_range::{
-    calibrate, calibration_request, full_grid, render_as_played, settings_for, GridPoint, KEYS,
-    NOTE_SECONDS, PLUCK_POSITIONS_M,
+    calibration_request, full_grid, render_as_played, settings_for, GridPoint, KEYS, NOTE_SECONDS,
+    PLUCK_POSITIONS_M,
 };
 use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
@@ -26,7 +28,6 @@ use std::collections::hash_map::DefaultHasher;
 use std::fmt::Write as _;
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// One tier's comparison over the grid.
 #[derive(Debug, Clone)]
@@ -73,30 +74,6 @@ impl TierOverGrid {
     }
 }
 
-/// The version of `core/`: its committed tree and any uncommitted change, or `None` without git.
-fn core_version(workspace: &Path) -> Option<String> {
-    let git = |args: &[&str]| {
-        Command::new("git")
-            .args(args)
-            .current_dir(workspace)
-            .output()
-            .ok()
-            .filter(|output| output.status.success())
-            .map(|output| output.stdout)
-    };
-    let tree = git(&["rev-parse", "HEAD:core"])?;
-    let diff = git(&["diff", "HEAD", "--", "core"])?;
-    let untracked = git(&["ls-files", "--others", "--exclude-standard", "--", "core"])?;
-    let mut hasher = DefaultHasher::new();
-    diff.hash(&mut hasher);
-    untracked.hash(&mut hasher);
-    Some(format!(
-        "{}-{:016x}",
-        String::from_utf8_lossy(&tree).trim(),
-        hasher.finish()
-    ))
-}
-
 fn cache_file(directory: &Path, version: &str, point: &GridPoint, sample_rate_hz: f64) -> PathBuf {
     let mut hasher = DefaultHasher::new();
     "tuned as played".hash(&mut hasher);
@@ -107,48 +84,6 @@ fn cache_file(directory: &Path, version: &str, point: &GridPoint, sample_rate_hz
     NOTE_SECONDS.to_bits().hash(&mut hasher);
     sample_rate_hz.to_bits().hash(&mut hasher);
     directory.join(format!("{:016x}.f32", hasher.finish()))
-}
-
-/// The cache file of the reference's calibration at `key` and `pluck_position_m`.
-fn calibration_cache_file(
-    directory: &Path,
-    version: &str,
-    key: u8,
-    pluck_position_m: f64,
-    sample_rate_hz: f64,
-) -> PathBuf {
-    let point = GridPoint {
-        key,
-        velocity: 127,
-        pluck_position_m,
-    };
-    let mut hasher = DefaultHasher::new();
-    "as-played calibration".hash(&mut hasher);
-    version.hash(&mut hasher);
-    format!("{:?}", settings_for(Quality::Reference, &point)).hash(&mut hasher);
-    key.hash(&mut hasher);
-    sample_rate_hz.to_bits().hash(&mut hasher);
-    directory.join(format!("{:016x}.asplayed", hasher.finish()))
-}
-
-/// A cached calibration: its offset in cents and its thread move in metres.
-fn read_cached_calibration(path: &Path) -> Option<(f64, f64)> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let mut numbers = text.split_whitespace().map(str::parse::<f64>);
-    let offset_cents = numbers.next()?.ok()?;
-    let thread_offset_m = numbers.next()?.ok()?;
-    Some((offset_cents, thread_offset_m))
-}
-
-fn write_cached_calibration(path: &Path, calibration: &Calibration) {
-    let temporary = path.with_extension("partial");
-    let text = format!(
-        "{:e} {:e}",
-        calibration.offset_cents, calibration.thread_offset_m
-    );
-    if std::fs::write(&temporary, text).is_ok() {
-        let _ = std::fs::rename(&temporary, path);
-    }
 }
 
 fn read_cached(path: &Path, samples: usize) -> Option<Vec<f64>> {
@@ -179,10 +114,8 @@ fn write_cached(path: &Path, output: &[f64]) {
 /// how far the reference sounds from the note it was tuned to (the other measures are zero).
 pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
     let grid = full_grid();
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap_or(Path::new("."))
-        .to_path_buf();
+    let workspace = workspace();
+    let calibration_cache = CalibrationCache::for_workspace();
     let cache = core_version(&workspace).map(|version| {
         let directory = workspace.join("target/bench-cache/playing-range");
         let _ = std::fs::create_dir_all(&directory);
@@ -211,27 +144,8 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
     let calibrations: Vec<Calibration> = calibration_jobs
         .par_iter()
         .map(|&(quality, key, position)| {
-            if quality != Quality::Reference {
-                return calibrate(quality, key, position, sample_rate_hz);
-            }
-            let path = cache.as_ref().map(|(dir, version)| {
-                calibration_cache_file(dir, version, key, position, sample_rate_hz)
-            });
-            if let Some((offset_cents, thread_offset_m)) =
-                path.as_deref().and_then(read_cached_calibration)
-            {
-                return Calibration {
-                    request: calibration_request(quality, key, position),
-                    sample_rate_hz,
-                    offset_cents,
-                    thread_offset_m,
-                };
-            }
-            let measured = calibrate(quality, key, position, sample_rate_hz);
-            if let Some(path) = path {
-                write_cached_calibration(&path, &measured);
-            }
-            measured
+            let request = calibration_request(quality, key, position);
+            calibration(calibration_cache.as_ref(), &request, sample_rate_hz).0
         })
         .collect();
     let calibration_of = |quality: Quality, point: &GridPoint| {

@@ -24,6 +24,7 @@
 //! log gets lines, not carriage returns).
 
 use crate::args::number_in;
+use crate::calibration_cache::{calibration, CalibrationCache, Source};
 use crate::plot::heatmap;
 use clap::builder::PossibleValuesParser;
 use clap::Parser;
@@ -96,6 +97,11 @@ pub struct RenderArgs {
     /// goes; it is never cut short.
     #[arg(long, value_name = "S", default_value_t = 3600.0, value_parser = number_in(1.0, 86_400.0))]
     max_seconds: f64,
+    /// Measure every string's as-played calibration afresh, neither reading nor keeping
+    /// calibrations in `target/calibration-cache/` (kept there by default, per version of
+    /// `core/`, so that rendering the same strings again skips their calibration renders).
+    #[arg(long)]
+    no_calibration_cache: bool,
 }
 
 /// Largest WAV data chunk: its length field has 32 bits.
@@ -118,6 +124,7 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         spectrum,
         jobs,
         max_seconds,
+        no_calibration_cache,
     } = args;
     let channels = if stereo { 2 } else { 1 };
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
@@ -192,7 +199,12 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         out.display()
     );
     let started = Instant::now();
-    let calibrations = calibrate(jobs, &settings, &score, sample_rate_hz)?;
+    let cache = if no_calibration_cache {
+        None
+    } else {
+        CalibrationCache::for_workspace()
+    };
+    let calibrations = calibrate(jobs, &settings, &score, sample_rate_hz, cache.as_ref())?;
     let mut progress = Progress::new(total, sample_rate_hz);
     let mut wav = PendingWav::create(&out, sample_rate_hz, channels)?;
     let mut peak = 0.0f32;
@@ -589,13 +601,15 @@ fn render_on(
 }
 
 /// Tunes every string the score plucks by its sustained pitch as played
-/// (`javari_core::tanpura::as_played`): each string is measured on `jobs` threads (rayon) and
-/// announced with the time it took. None when the preset turns the as-played tuning off.
+/// (`javari_core::tanpura::as_played`): each string's calibration is read from `cache` when an
+/// earlier run kept it, else measured on `jobs` threads (rayon) and kept; announced with the
+/// time it took. None when the preset turns the as-played tuning off.
 fn calibrate(
     jobs: usize,
     settings: &EngineSettings,
     score: &Score,
     sample_rate_hz: f64,
+    cache: Option<&CalibrationCache>,
 ) -> Result<Vec<Calibration>, String> {
     let requests = calibration_requests(settings, score);
     if requests.is_empty() {
@@ -606,12 +620,16 @@ fn calibrate(
         .num_threads(jobs.max(1))
         .build()
         .map_err(|error| format!("cannot start {jobs} threads: {error}"))?;
-    let calibrations: Vec<Calibration> = pool.install(|| {
+    let (calibrations, sources): (Vec<Calibration>, Vec<Source>) = pool.install(|| {
         requests
             .par_iter()
-            .map(|request| Calibration::measure(request, sample_rate_hz))
-            .collect()
+            .map(|request| calibration(cache, request, sample_rate_hz))
+            .unzip()
     });
+    let cached = sources
+        .iter()
+        .filter(|&&source| source == Source::Cached)
+        .count();
     let largest = calibrations
         .iter()
         .map(|calibration| calibration.offset_cents.abs())
@@ -631,9 +649,20 @@ fn calibrate(
             if moved.len() == 1 { "" } else { "s" }
         )
     };
+    let kept = match cached {
+        0 => String::new(),
+        n if n == calibrations.len() => {
+            "; every calibration read from target/calibration-cache, measured by an earlier run"
+                .to_string()
+        }
+        n => format!(
+            "; {n} of the calibrations read from target/calibration-cache, measured by an \
+             earlier run"
+        ),
+    };
     eprintln!(
         "tuned {} string{} by their sustained pitch as played in {:.1} s (largest offset from \
-         the linearised tuning {largest:.1} cents{threads})",
+         the linearised tuning {largest:.1} cents{threads}{kept})",
         calibrations.len(),
         if calibrations.len() == 1 { "" } else { "s" },
         started.elapsed().as_secs_f64()
@@ -801,7 +830,7 @@ mod tests {
             ..RenderOptions::default()
         };
         // Tuned as played, as `render` does.
-        let calibrations = calibrate(2, &settings, &score, options.sample_rate_hz).unwrap();
+        let calibrations = calibrate(2, &settings, &score, options.sample_rate_hz, None).unwrap();
         assert!(!calibrations.is_empty());
         let bits = |jobs| {
             let mut bits = Vec::new();
@@ -824,6 +853,44 @@ mod tests {
         for jobs in [2, 3, 8] {
             assert!(one == bits(jobs), "{jobs} jobs differ from one");
         }
+    }
+
+    /// A render keeps the calibrations it measured, exactly, and a second render of the same
+    /// strings reads them instead of measuring.
+    #[test]
+    fn a_render_reads_back_the_calibrations_an_earlier_one_measured() {
+        let mut score = Score::default();
+        for (index, note) in [48u8, 55].into_iter().enumerate() {
+            score.note(0.05 * index as f64, 0.2, note, 0.8);
+        }
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = Quality::Draft;
+        let directory = tempfile::tempdir().unwrap();
+        let cache = CalibrationCache::at(directory.path().to_path_buf(), "test");
+        let fresh = calibrate(1, &settings, &score, 44_100.0, None).unwrap();
+        let first = calibrate(1, &settings, &score, 44_100.0, Some(&cache)).unwrap();
+        assert_eq!(fresh.len(), 2);
+        assert_eq!(first, fresh);
+        for calibration in &first {
+            assert_eq!(
+                cache.get(&calibration.request, 44_100.0),
+                Some(*calibration)
+            );
+            // Marked, so that a calibration read back tells itself from a measured one.
+            cache.put(&Calibration {
+                offset_cents: calibration.offset_cents + 1.0,
+                ..*calibration
+            });
+        }
+        let second = calibrate(1, &settings, &score, 44_100.0, Some(&cache)).unwrap();
+        for (second, first) in second.iter().zip(&first) {
+            assert_eq!(second.offset_cents, first.offset_cents + 1.0);
+        }
+        // Without the cache, measured again.
+        assert_eq!(
+            calibrate(1, &settings, &score, 44_100.0, None).unwrap(),
+            fresh
+        );
     }
 
     /// A fresh directory for one test's files.

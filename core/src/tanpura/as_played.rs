@@ -415,6 +415,24 @@ pub struct CalibrationRequest {
     pub velocities: [f64; 2],
 }
 
+impl CalibrationRequest {
+    /// The request as it is measured: settings and pluck clamped to their ranges, velocities to
+    /// [0, 1] (a NaN velocity taken as full).
+    pub fn clamped(&self) -> Self {
+        Self {
+            settings: self.settings.clamped(),
+            pluck: self.pluck.clamped(),
+            velocities: self.velocities.map(|velocity| {
+                if velocity.is_nan() {
+                    1.0
+                } else {
+                    velocity.clamp(0.0, 1.0)
+                }
+            }),
+        }
+    }
+}
+
 /// Calibrations an engine holds at once: every string of a six-string drone and the notes of
 /// a phrase several times over.
 pub const AS_PLAYED_CAPACITY: usize = 48;
@@ -433,17 +451,7 @@ pub struct Calibration {
 impl Calibration {
     /// Measures the calibration of a string (renders: off the audio thread).
     pub fn measure(request: &CalibrationRequest, sample_rate_hz: f64) -> Self {
-        let request = CalibrationRequest {
-            settings: request.settings.clamped(),
-            pluck: request.pluck.clamped(),
-            velocities: request.velocities.map(|velocity| {
-                if velocity.is_nan() {
-                    1.0
-                } else {
-                    velocity.clamp(0.0, 1.0)
-                }
-            }),
-        };
+        let request = request.clamped();
         let as_played = as_played_calibration(
             &request.settings,
             &request.pluck,
