@@ -199,3 +199,69 @@ fn reference_notes_at_the_crest_settle_with_the_thread_moved_as_a_player_sets_it
         }
     });
 }
+
+/// A string can be bistable between ends that agree: the studio tier's key 54 plucked at
+/// 0.20 m, centred by its soft and firm plucks alone, has them within
+/// [`UNSETTLED_SPREAD_CENTS`] of each other while a pluck midway sounds more than 2 cents off
+/// the note. The calibration checks that pluck too, and sets the jawari.
+#[test]
+fn a_string_bistable_between_agreeing_ends_gets_its_jawari_set() {
+    use javari_core::tanpura::as_played::{as_played_offset_cents, UNSETTLED_SPREAD_CENTS};
+    let mut settings = settings();
+    settings.voice.quality = Quality::Studio;
+    settings.pluck.position_m = 0.20;
+    let key = 54u8;
+    let calibration = calibrate(&settings, &[key])[0];
+    assert!(
+        calibration.thread_offset_m != 0.0,
+        "the thread was not moved"
+    );
+    let unmoved = Calibration {
+        offset_cents: as_played_offset_cents(
+            &calibration.request.settings,
+            &calibration.request.pluck,
+            calibration.request.velocities,
+            SAMPLE_RATE,
+        ),
+        thread_offset_m: 0.0,
+        ..calibration
+    };
+    let target = settings.tuning.note_hz(key);
+    let heard = |calibration: &Calibration| {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = [40u8, 75, 110]
+                .map(|velocity| {
+                    let settings = &settings;
+                    scope.spawn(move || {
+                        let mut engine = Engine::new(settings, SAMPLE_RATE, 1);
+                        engine.set_calibration(calibration);
+                        let signal = render(&mut engine, key, f32::from(velocity) / 127.0);
+                        cents(sustained_pitch_hz(&signal, SAMPLE_RATE, target), target)
+                    })
+                })
+                .into_iter()
+                .collect();
+            handles
+                .into_iter()
+                .map(|handle| handle.join().expect("a render panicked"))
+                .collect::<Vec<f64>>()
+        })
+    };
+    let [soft, midway, firm] = heard(&unmoved)[..] else {
+        unreachable!()
+    };
+    assert!(
+        (soft - firm).abs() <= UNSETTLED_SPREAD_CENTS,
+        "the ends alone would have called it unsettled: {soft:.2}, {firm:.2} cents"
+    );
+    assert!(
+        midway.abs() > TOLERANCE_CENTS,
+        "midway already within {TOLERANCE_CENTS} cents unmoved: {midway:.2}"
+    );
+    let moved = heard(&calibration);
+    assert!(
+        moved.iter().all(|off| off.abs() <= TOLERANCE_CENTS),
+        "as played with the thread moved by {:+.2} mm: {moved:.2?} cents",
+        calibration.thread_offset_m * 1e3
+    );
+}

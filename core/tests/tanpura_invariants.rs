@@ -338,3 +338,117 @@ fn condensed_candidate_margin_rarely_redoes_a_step() {
         "{redone} of {contact_steps} steps with contact redone"
     );
 }
+
+/// The studio tier's string: EI raised for its vibration (here by a quarter, more than the tier
+/// raises it at the top key), resting as the string of the true EI rests (the rest preload).
+fn raised_stiffness(config: FdStringConfig) -> FdStringConfig {
+    let mut raised = config;
+    raised.time_step_s = 2.0 / SAMPLE_RATE;
+    raised.rest_bending_stiffness_n_m2 = Some(config.string.bending_stiffness_n_m2);
+    raised.string.bending_stiffness_n_m2 *= 1.25;
+    raised
+}
+
+#[test]
+fn a_string_with_raised_stiffness_rests_where_the_true_string_rests_and_stays_there() {
+    let true_string = FdString::new(FdStringConfig::REFERENCE);
+    let mut raised = FdString::new(raised_stiffness(FdStringConfig::REFERENCE));
+    let mut unpreloaded_config = raised_stiffness(FdStringConfig::REFERENCE);
+    unpreloaded_config.rest_bending_stiffness_n_m2 = None;
+    let unpreloaded = FdString::new(unpreloaded_config);
+    let distance = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    };
+    assert_eq!(
+        raised.rest_displacement_m(),
+        true_string.rest_displacement_m()
+    );
+    assert_eq!(
+        raised.rest_contact_end_m(),
+        true_string.rest_contact_end_m()
+    );
+    // Without the preload the stiffer string rests elsewhere (by micrometres near the thread).
+    let apart = distance(
+        unpreloaded.rest_displacement_m(),
+        true_string.rest_displacement_m(),
+    );
+    assert!(apart > 1e-7, "{apart:e} m");
+    // Left alone, the preloaded string does not move off its rest state.
+    for _ in 0..4_410 {
+        raised.step();
+    }
+    let drift = distance(raised.displacement_m(), raised.rest_displacement_m());
+    assert!(drift < 1e-13, "drifted {drift:e} m from rest");
+}
+
+#[test]
+fn a_string_with_raised_stiffness_keeps_the_energy_balance() {
+    let mut lossless = raised_stiffness(FdStringConfig::REFERENCE.lossless());
+    lossless.track_energy = true;
+    let mut string = plucked(lossless);
+    let initial = string.energy_j();
+    let mut worst = 0.0f64;
+    for _ in 0..(0.25 * SAMPLE_RATE) as usize {
+        string.step();
+        worst = worst.max((string.energy_j() - initial).abs() / initial.abs());
+    }
+    assert!(worst <= 1e-10, "lossless: relative energy drift {worst:e}");
+    assert!(string.newton_stats().mean_iterations() > 1.0);
+
+    let mut lossy = raised_stiffness(FdStringConfig::REFERENCE);
+    lossy.track_energy = true;
+    let mut string = plucked(lossy);
+    let initial = string.energy_j();
+    let mut previous = initial;
+    let (mut worst_balance, mut worst_increase) = (0.0f64, 0.0f64);
+    for _ in 0..(0.25 * SAMPLE_RATE) as usize {
+        string.step();
+        let energy = string.energy_j();
+        worst_increase = worst_increase.max((energy - previous) / initial.abs());
+        worst_balance = worst_balance
+            .max((energy + string.cumulative_losses_j() - initial).abs() / initial.abs());
+        previous = energy;
+    }
+    assert!(string.cumulative_losses_j() > 0.0);
+    assert!(
+        worst_increase <= 1e-14,
+        "H rose by {worst_increase:e} of H(0)"
+    );
+    assert!(worst_balance <= 1e-10, "balance error {worst_balance:e}");
+}
+
+/// The studio tier raises EI for its vibration only: at every key its string rests exactly
+/// where the reference tier's rests (the crest contact that decides how keys 48–54 sound).
+#[test]
+fn the_studio_tier_rests_where_the_reference_rests() {
+    use javari_core::engine::pitch::note_to_hz;
+    use javari_core::tanpura::quality::Quality;
+    use javari_core::tanpura::voice::VoiceSettings;
+    for key in [36u8, 48, 51, 54, 64] {
+        let settings = VoiceSettings {
+            fundamental_hz: note_to_hz(key),
+            ..VoiceSettings::default()
+        };
+        let string = |quality| {
+            FdString::new(
+                settings
+                    .fd_config_at(quality, 44_100.0)
+                    .expect("an FD tier"),
+            )
+        };
+        let (studio, reference) = (string(Quality::Studio), string(Quality::Reference));
+        assert!(
+            studio.config().string.bending_stiffness_n_m2
+                > reference.config().string.bending_stiffness_n_m2,
+            "key {key}: the studio's EI is raised"
+        );
+        assert_eq!(
+            studio.rest_displacement_m(),
+            reference.rest_displacement_m(),
+            "key {key}"
+        );
+    }
+}

@@ -27,9 +27,10 @@
 //! sound 10 cents apart (a soft pluck stays on the crest, a firm one lifts it off), and centring
 //! them is all a tension can do. A player then moves the string's thread until the note speaks
 //! the same at every strength, keeping the jawari's brightness, and so does the calibration
-//! ([`as_played_calibration`]). If the soft and firm ends still lie more than
-//! [`UNSETTLED_SPREAD_CENTS`] apart at the second centring pass (centred, each would lie more
-//! than 2 cents off), it tries thread moves of 1 to [`THREAD_STEPS`] steps of [`THREAD_STEP_M`]
+//! ([`as_played_calibration`]). If the soft end, a pluck midway and the firm end still lie more
+//! than [`UNSETTLED_SPREAD_CENTS`] apart at the second centring pass (centred, one would lie
+//! more than 2 cents off; the pluck midway counts because a string can be bistable between ends
+//! that agree), it tries thread moves of 1 to [`THREAD_STEPS`] steps of [`THREAD_STEP_M`]
 //! towards the crest, then away from it, and keeps the first that settles the string:
 //!
 //! - the two ends at the unmoved string's tuning lie within twice [`SETTLED_CENTS`] of each
@@ -51,8 +52,8 @@
 //! also settle them but takes 6–13 dB off their level above 2 kHz (`examples/jawari_moves.rs`,
 //! README).
 //!
-//! Each pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, each thread move
-//! tried two more and the one kept three more again, so a calibration is an offline job (the
+//! The first pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, the second
+//! three, each thread move tried two more and the one kept three more again, so a calibration is an offline job (the
 //! renderer before it renders, a background thread in the plugin), never the audio thread's.
 //! The result is a plain number of cents and a thread move per string, which the engine adds to
 //! the string's target and thread position ([`AsPlayedTuning`]).
@@ -76,9 +77,9 @@ pub const MAX_OFFSET_CENTS: f64 = 50.0;
 /// velocities lies within this of the note, cents (below the 2 cents a player hears as out of
 /// tune, for the velocities between those three).
 pub const SETTLED_CENTS: f64 = 1.5;
-/// A string is unsettled when the sustained pitches of its soft and firm plucks lie more than
-/// this apart, cents: centred, each would lie more than 2 cents off the note, which a player
-/// hears as out of tune.
+/// A string is unsettled when the sustained pitches of its soft, midway and firm plucks lie
+/// more than this apart, cents: centred, one would lie more than 2 cents off the note, which a
+/// player hears as out of tune.
 pub const UNSETTLED_SPREAD_CENTS: f64 = 4.0;
 /// The thread moves a calibration tries on an unsettled string: multiples of this, m.
 pub const THREAD_STEP_M: f64 = 0.05e-3;
@@ -304,8 +305,8 @@ fn check<const N: usize>(
 }
 
 /// The calibration of a string as a player sets it (module doc): the offset that centres its
-/// soft and firm plucks on the note ([`as_played_offset_cents`]) and, where the two lie more
-/// than [`UNSETTLED_SPREAD_CENTS`] apart at the second pass, the smallest thread move of at
+/// soft and firm plucks on the note ([`as_played_offset_cents`]) and, where those and a pluck
+/// midway lie more than [`UNSETTLED_SPREAD_CENTS`] apart at the second pass, the smallest thread move of at
 /// most ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], towards the crest first, that settles the soft,
 /// midway and firm plucks while keeping the brightness within [`BRIGHTNESS_KEPT_DB`].
 /// Allocates and renders: off the audio thread.
@@ -339,7 +340,7 @@ pub fn as_played_calibration(
         settings.fundamental_hz,
         first_offset,
         pluck,
-        velocities,
+        check_velocities(velocities),
         sample_rate_hz,
     );
     let offset_cents = first_offset + second.centring_cents();

@@ -16,7 +16,8 @@
 //!   seed's own discretisation (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm,
 //!   Δx_c = 0.15 mm) with a tolerance at round-off; Studio halves the oversampling and keeps the
 //!   seed's grids. Studio's EI is raised so that its inharmonicity matches the reference's
-//!   (`voice.rs`, `dispersion_compensated_stiffness`).
+//!   (`voice.rs`, `dispersion_compensated_stiffness`), for the vibration only: its string rests
+//!   where the reference's rests (the FD rest preload, `fd/mod.rs`).
 //!
 //! Every tier keeps its scheme's exact discrete energy balance; the balance holds only for a
 //! converged Newton: a tolerance of 1e-8 m let an FD tier's energy grow by 0.3 % per step at

@@ -235,6 +235,8 @@ impl VoiceSettings {
             ..ThreadSettings::SEED
         });
         config.string = self.string_parameters(config.speaking_start_m());
+        // The raised EI is the vibration's; the string rests as the true one does.
+        config.rest_bending_stiffness_n_m2 = Some(config.string.bending_stiffness_n_m2);
         config.string.bending_stiffness_n_m2 = dispersion_compensated_stiffness(
             quality,
             &config.string,
@@ -327,6 +329,12 @@ fn dispersion_per_n_squared(
 /// partials of every FD tier stay close to the reference's. The reference keeps the seed's EI
 /// (its own dispersion flattens the tenth partial by about 2.6 cents against the continuous
 /// string by the leading-order estimate above, which the modal tiers reproduce exactly).
+///
+/// The raised EI is the vibration's: the rest state is solved with the true EI
+/// ([`FdStringConfig::rest_bending_stiffness_n_m2`]). Raised everywhere, it made the studio
+/// string's static shape near the thread differ from the reference's by micrometres and
+/// decided differently which keys rest on the crest (its worst sustained pitch over the
+/// playing range, 14.7 cents at key 54, was that; README, stop 34).
 fn dispersion_compensated_stiffness(
     quality: Quality,
     string: &StringParameters,

@@ -28,6 +28,16 @@
 //! deepest penetration is computed when asked for from what the last step left in the barrier
 //! grids.
 //!
+//! **Rest preload** (not in the seed; the studio tier's). A tier that raises EI to cancel its
+//! coarser time step's dispersion (`voice.rs`) would also change the string's static shape near
+//! the thread by micrometres, and with it which keys rest on the bridge's crest. With
+//! [`FdStringConfig::rest_bending_stiffness_n_m2`] the rest state `ȳ` is solved with the true EI
+//! and a constant force density `p = g(ȳ) − g_true(ȳ)` (`g = K y − b` of `operator.rs`) is added,
+//! so that `g(ȳ) − p` is the true string's restoring force at rest: `ȳ` is an equilibrium of
+//! the scheme and the raised EI acts on the motion about it. `p` is constant, so the potential
+//! gains `−Δx Σ p_m y_m` (its gradient is exact) and the energy balance below holds unchanged
+//! (tested).
+//!
 //! Energy (eq. 8–9): `H = Σ Δx [p²/2ρA] + V_string + Δx_b Σ k_b/2⌊a⌋² + Δx_c Σ k_c/2⌊a⌋²`.
 //! The scheme gives `Hⁿ⁺¹ − Hⁿ = −(losses over the step)` exactly; a pluck changes H by the
 //! work the finger does, which is booked as external work. So at every step
@@ -78,6 +88,11 @@ pub struct FdStringConfig {
     /// passes per step; the energy-balance tests and research tools turn it on, the audio path
     /// leaves it off). Also switchable on a built string with [`FdString::set_track_energy`].
     pub track_energy: bool,
+    /// The bending stiffness the rest state is solved with, N·m², where it differs from the
+    /// string's (`None`: the string's own). The studio tier raises EI so that its vibration has
+    /// the reference's dispersion (`voice.rs`); with the true EI here its string still rests
+    /// where the reference's rests (see [`FdString`]'s rest preload).
+    pub rest_bending_stiffness_n_m2: Option<f64>,
 }
 
 impl FdStringConfig {
@@ -92,6 +107,7 @@ impl FdStringConfig {
         newton: NewtonSettings::REFERENCE,
         solver: SolverKind::Condensed,
         track_energy: false,
+        rest_bending_stiffness_n_m2: None,
     };
 
     /// The same with all losses off (γ = η = r_b = r_c = 0).
@@ -284,6 +300,12 @@ pub struct FdString {
     scaled_momentum: Vec<f64>,
     /// The static equilibrium on bridge and thread (no finger, no motion).
     rest_displacement: Vec<f64>,
+    /// The rest preload `p` (N/m, full-node vector, zero at the ends; zero unless
+    /// [`FdStringConfig::rest_bending_stiffness_n_m2`] is set): a constant force density that
+    /// makes the rest state of the true EI an equilibrium of the string's own operator.
+    preload: Vec<f64>,
+    /// Whether `preload` is not all zero (the step then adds it).
+    preloaded: bool,
     scratch: Vec<f64>,
     kernels: Kernels,
     /// Whether the last step had contact (the barrier grids then hold its forces and steps).
@@ -338,6 +360,8 @@ impl FdString {
             displacement: vec![0.0; n + 1],
             scaled_momentum: vec![0.0; n + 1],
             rest_displacement: vec![0.0; n + 1],
+            preload: vec![0.0; n + 1],
+            preloaded: false,
             scratch: vec![0.0; n + 1],
             kernels: Kernels::detect(),
             touched_last_step: false,
@@ -474,8 +498,42 @@ impl FdString {
         for (m, y) in rest.iter_mut().enumerate() {
             *y = left * (1.0 - m as f64 / n as f64);
         }
-        if !self.solve_static(&mut rest) {
-            self.static_solve_failures += 1;
+        self.preload.fill(0.0);
+        self.preloaded = false;
+        let vibrating = self.config.string;
+        match self
+            .config
+            .rest_bending_stiffness_n_m2
+            .filter(|&stiffness| stiffness != vibrating.bending_stiffness_n_m2)
+        {
+            Some(rest_stiffness) => {
+                // The rest state of the string with the true EI, and the preload
+                // p = g_vibrating(y_rest) − g_true(y_rest) that makes it an equilibrium of the
+                // string's own operator: g_vibrating(y_rest) − p = g_true(y_rest) = the contact
+                // force at rest.
+                self.operator.set_parameters(StringParameters {
+                    bending_stiffness_n_m2: rest_stiffness,
+                    ..vibrating
+                });
+                if !self.solve_static(&mut rest) {
+                    self.static_solve_failures += 1;
+                }
+                self.operator.restoring_force(&rest, &mut self.scratch);
+                self.operator.set_parameters(vibrating);
+                self.operator.restoring_force(&rest, &mut self.preload);
+                for (preload, true_force) in self.preload.iter_mut().zip(&self.scratch) {
+                    *preload -= true_force;
+                }
+                self.preloaded = self.preload.iter().all(|p| p.is_finite());
+                if !self.preloaded {
+                    self.preload.fill(0.0);
+                }
+            }
+            None => {
+                if !self.solve_static(&mut rest) {
+                    self.static_solve_failures += 1;
+                }
+            }
         }
         self.rest_nut_force_n = self.operator.nut_force_n(&rest);
         self.rest_bridge_force_n = self.static_barrier_force_n(&rest);
@@ -530,7 +588,7 @@ impl FdString {
             }
             // G(y) on the interior, shifted down one index for the solver.
             for m in 1..n {
-                solver.residual[m - 1] = solver.residual[m] - solver.contact[m];
+                solver.residual[m - 1] = solver.residual[m] - self.preload[m] - solver.contact[m];
             }
             if solver.jacobian_factor.factorise(&solver.jacobian).is_err() {
                 return false;
@@ -575,7 +633,7 @@ impl FdString {
     /// The energy whose minimum is the static equilibrium: the string's potential plus every
     /// active barrier's (the finger's too while it presses), J.
     fn static_energy_j(&self, displacement: &[f64]) -> f64 {
-        let mut energy = self.operator.potential_energy_j(displacement);
+        let mut energy = self.string_potential_energy_j(displacement);
         for barrier in [
             &self.solver.bridge,
             &self.solver.thread,
@@ -691,6 +749,14 @@ impl FdString {
             &mut self.scratch,
             &mut solver.predictor_rhs,
         );
+        if self.preloaded {
+            // The rest preload enters the constant part: −2(D yⁿ − d_b − qⁿ) + 2(Δt²/4ρA) p.
+            kernels.axpy(
+                2.0 * self.operator.force_scale(),
+                &self.preload,
+                &mut solver.predictor_rhs,
+            );
+        }
         solver.step.copy_from_slice(&solver.predictor_rhs);
         solver.step_factor.solve_in_place(&mut solver.step[1..n]);
 
@@ -789,9 +855,25 @@ impl FdString {
         self.config.track_energy = track_energy;
     }
 
+    /// The string's potential energy at a full-node displacement, J: V of eq. 8–9 and, with a
+    /// rest preload, its work `−Δx Σ p_m y_m` (so that `g − p` stays the gradient).
+    fn string_potential_energy_j(&self, displacement: &[f64]) -> f64 {
+        let mut energy = self.operator.potential_energy_j(displacement);
+        if self.preloaded {
+            let work: f64 = self
+                .preload
+                .iter()
+                .zip(displacement)
+                .map(|(p, y)| p * y)
+                .sum();
+            energy -= self.operator.spacing_m() * work;
+        }
+        energy
+    }
+
     /// The discrete energy H (eq. 8–9) of the current state, J.
     pub fn energy_j(&self) -> f64 {
-        let mut energy = self.operator.potential_energy_j(&self.displacement)
+        let mut energy = self.string_potential_energy_j(&self.displacement)
             + self.operator.kinetic_energy_j(&self.scaled_momentum);
         for barrier in [&self.solver.bridge, &self.solver.thread] {
             if barrier.is_active() {
@@ -803,7 +885,7 @@ impl FdString {
 
     /// H at the rest state, J: what a silent string holds (tension over the bridge).
     pub fn rest_energy_j(&self) -> f64 {
-        let mut energy = self.operator.potential_energy_j(&self.rest_displacement);
+        let mut energy = self.string_potential_energy_j(&self.rest_displacement);
         for barrier in [&self.solver.bridge, &self.solver.thread] {
             if barrier.is_active() {
                 energy += barrier.potential_energy_j(&self.rest_displacement);
