@@ -45,6 +45,21 @@ fn calibrate(settings: &EngineSettings, notes: &[u8]) -> Vec<Calibration> {
     })
 }
 
+/// The same string with its thread left where the player put it, centred by the two passes
+/// alone.
+fn unmoved(calibration: &Calibration) -> Calibration {
+    Calibration {
+        offset_cents: javari_core::tanpura::as_played::as_played_offset_cents(
+            &calibration.request.settings,
+            &calibration.request.pluck,
+            calibration.request.velocities,
+            SAMPLE_RATE,
+        ),
+        thread_offset_m: 0.0,
+        ..*calibration
+    }
+}
+
 /// One note-on at velocity `velocity` (0–1) and the output up to the end of the sustain window.
 fn render(engine: &mut Engine, note: u8, velocity: f32) -> Vec<f64> {
     let samples = (CALIBRATION_SECONDS * SAMPLE_RATE).round() as usize;
@@ -134,9 +149,7 @@ fn every_first_drone_string_sounds_within_two_cents_as_the_drone_plucks_it() {
 /// more than 2 cents off, so the test fails if the engine stopped applying it.
 #[test]
 fn reference_notes_at_the_crest_settle_with_the_thread_moved_as_a_player_sets_it() {
-    use javari_core::tanpura::as_played::{
-        as_played_offset_cents, brightness_db, THREAD_STEPS, THREAD_STEP_M,
-    };
+    use javari_core::tanpura::as_played::{brightness_db, THREAD_STEPS, THREAD_STEP_M};
     let mut settings = settings();
     settings.voice.quality = Quality::Reference;
     let keys = [51u8, 52];
@@ -152,16 +165,7 @@ fn reference_notes_at_the_crest_settle_with_the_thread_moved_as_a_player_sets_it
                     "key {key}: thread moved by {:.3} mm",
                     moved_m * 1e3
                 );
-                let unmoved = Calibration {
-                    offset_cents: as_played_offset_cents(
-                        &calibration.request.settings,
-                        &calibration.request.pluck,
-                        calibration.request.velocities,
-                        SAMPLE_RATE,
-                    ),
-                    thread_offset_m: 0.0,
-                    ..*calibration
-                };
+                let unmoved = unmoved(calibration);
                 let target = settings.tuning.note_hz(key);
                 let mut worst = [0.0f64; 2];
                 let mut brightness = [0.0f64; 2];
@@ -206,7 +210,7 @@ fn reference_notes_at_the_crest_settle_with_the_thread_moved_as_a_player_sets_it
 /// the note. The calibration checks that pluck too, and sets the jawari.
 #[test]
 fn a_string_bistable_between_agreeing_ends_gets_its_jawari_set() {
-    use javari_core::tanpura::as_played::{as_played_offset_cents, UNSETTLED_SPREAD_CENTS};
+    use javari_core::tanpura::as_played::UNSETTLED_SPREAD_CENTS;
     let mut settings = settings();
     settings.voice.quality = Quality::Studio;
     settings.pluck.position_m = 0.20;
@@ -216,16 +220,7 @@ fn a_string_bistable_between_agreeing_ends_gets_its_jawari_set() {
         calibration.thread_offset_m != 0.0,
         "the thread was not moved"
     );
-    let unmoved = Calibration {
-        offset_cents: as_played_offset_cents(
-            &calibration.request.settings,
-            &calibration.request.pluck,
-            calibration.request.velocities,
-            SAMPLE_RATE,
-        ),
-        thread_offset_m: 0.0,
-        ..calibration
-    };
+    let unmoved = unmoved(&calibration);
     let target = settings.tuning.note_hz(key);
     let heard = |calibration: &Calibration| {
         std::thread::scope(|scope| {

@@ -11,15 +11,20 @@
 //! test fails if that, or its band levels, or the reference's own tuning, parts.
 
 use javari_core::analysis::cents;
-use javari_core::analysis::listening::{compare, sustained_pitch_hz};
+use javari_core::analysis::listening::{compare, sustained_pitch_hz, ListeningDifference};
 use javari_core::analysis::playing_range::{render, GridPoint, NOTE_SECONDS};
 use javari_core::tanpura::quality::Quality;
 
 const SAMPLE_RATE: f64 = 44_100.0;
 
-#[test]
-fn the_live_tier_sounds_like_the_reference_across_the_range() {
-    let points: Vec<GridPoint> = [39u8, 57, 63]
+/// Single plucks of `keys` at velocities 40 and 127 (at 0.35 m), each rendered at `tier` and at
+/// the reference (the reference renders dominate the time: one thread per pluck), with the
+/// measures of the one against the other.
+fn against_the_reference(
+    tier: Quality,
+    keys: &[u8],
+) -> Vec<(GridPoint, ListeningDifference, Vec<f64>)> {
+    let points: Vec<GridPoint> = keys
         .iter()
         .flat_map(|&key| {
             [40u8, 127].map(|velocity| GridPoint {
@@ -29,16 +34,16 @@ fn the_live_tier_sounds_like_the_reference_across_the_range() {
             })
         })
         .collect();
-    // The reference renders dominate the time: one thread per pluck.
-    let renders: Vec<(Vec<f64>, Vec<f64>)> = std::thread::scope(|scope| {
+    std::thread::scope(|scope| {
         let handles: Vec<_> = points
             .iter()
             .map(|point| {
                 scope.spawn(move || {
-                    (
-                        render(Quality::Live, point, NOTE_SECONDS, SAMPLE_RATE),
-                        render(Quality::Reference, point, NOTE_SECONDS, SAMPLE_RATE),
-                    )
+                    let mine = render(tier, point, NOTE_SECONDS, SAMPLE_RATE);
+                    let reference = render(Quality::Reference, point, NOTE_SECONDS, SAMPLE_RATE);
+                    let difference = compare(&mine, &reference, SAMPLE_RATE, point.nominal_hz());
+                    eprintln!("{}: {difference:?}", point.label());
+                    (*point, difference, reference)
                 })
             })
             .collect();
@@ -46,28 +51,37 @@ fn the_live_tier_sounds_like_the_reference_across_the_range() {
             .into_iter()
             .map(|handle| handle.join().expect("render thread"))
             .collect()
-    });
-    for (point, (live, reference)) in points.iter().zip(&renders) {
-        let nominal = point.nominal_hz();
-        let difference = compare(live, reference, SAMPLE_RATE, nominal);
-        let label = point.label();
-        eprintln!("{label}: {difference:?}");
+    })
+}
+
+/// Fails unless the sustained pitch and band levels lie within `cents` and `db` of the
+/// reference's.
+fn assert_within(point: &GridPoint, difference: &ListeningDifference, cents: f64, db: f64) {
+    let label = point.label();
+    assert!(
+        difference.sustained_cents.abs() <= cents,
+        "{label}: sustained pitch {:.2} cents from the reference",
+        difference.sustained_cents
+    );
+    assert!(
+        difference.band_level_db <= db,
+        "{label}: band levels {:.1} dB RMS from the reference",
+        difference.band_level_db
+    );
+}
+
+#[test]
+fn the_live_tier_sounds_like_the_reference_across_the_range() {
+    for (point, difference, reference) in against_the_reference(Quality::Live, &[39, 57, 63]) {
         // Measured: 0.1–2.25 cents, 2.9–10.4 dB.
-        assert!(
-            difference.sustained_cents.abs() <= 3.0,
-            "{label}: sustained pitch {:.2} cents from the reference",
-            difference.sustained_cents
-        );
-        assert!(
-            difference.band_level_db <= 12.0,
-            "{label}: band levels {:.1} dB RMS from the reference",
-            difference.band_level_db
-        );
+        assert_within(&point, &difference, 3.0, 12.0);
         // The reference is tuned to the key (measured within 0.3 cents here).
-        let reference_pitch = sustained_pitch_hz(reference, SAMPLE_RATE, nominal);
+        let nominal = point.nominal_hz();
+        let reference_pitch = sustained_pitch_hz(&reference, SAMPLE_RATE, nominal);
         assert!(
             cents(reference_pitch, nominal).abs() <= 1.0,
-            "{label}: the reference sounds {:.2} cents from its key",
+            "{}: the reference sounds {:.2} cents from its key",
+            point.label(),
             cents(reference_pitch, nominal)
         );
     }
@@ -83,46 +97,7 @@ fn the_live_tier_sounds_like_the_reference_across_the_range() {
 /// the crest and not the other's: the calibration as played sets those strings' jawari.)
 #[test]
 fn the_studio_tier_sounds_like_the_reference_at_the_crest_keys() {
-    let points: Vec<GridPoint> = [49u8, 50]
-        .iter()
-        .flat_map(|&key| {
-            [40u8, 127].map(|velocity| GridPoint {
-                key,
-                velocity,
-                pluck_position_m: 0.35,
-            })
-        })
-        .collect();
-    let renders: Vec<(Vec<f64>, Vec<f64>)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = points
-            .iter()
-            .map(|point| {
-                scope.spawn(move || {
-                    (
-                        render(Quality::Studio, point, NOTE_SECONDS, SAMPLE_RATE),
-                        render(Quality::Reference, point, NOTE_SECONDS, SAMPLE_RATE),
-                    )
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|handle| handle.join().expect("render thread"))
-            .collect()
-    });
-    for (point, (studio, reference)) in points.iter().zip(&renders) {
-        let difference = compare(studio, reference, SAMPLE_RATE, point.nominal_hz());
-        let label = point.label();
-        eprintln!("{label}: {difference:?}");
-        assert!(
-            difference.sustained_cents.abs() <= 1.0,
-            "{label}: sustained pitch {:.2} cents from the reference",
-            difference.sustained_cents
-        );
-        assert!(
-            difference.band_level_db <= 5.0,
-            "{label}: band levels {:.1} dB RMS from the reference",
-            difference.band_level_db
-        );
+    for (point, difference, _) in against_the_reference(Quality::Studio, &[49, 50]) {
+        assert_within(&point, &difference, 1.0, 5.0);
     }
 }

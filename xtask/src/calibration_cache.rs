@@ -6,8 +6,8 @@
 //! (stop 32). It depends only on the string's request (settings, pluck, velocities), the sample
 //! rate and the code that renders it, so it is kept under `target/calibration-cache/`, one small
 //! text file per calibration, named by a hash of
-//! - the version of `core/` (its committed git tree, plus a hash of any uncommitted or untracked
-//!   change to it; without git nothing is cached),
+//! - the version of `core/` (its committed git tree, plus a hash of any uncommitted change to
+//!   it and of its untracked files' names and contents; without git nothing is cached),
 //! - the vector unit the kernels run on (`javari_core::simd::Kernels`: AVX-512, AVX2+FMA and
 //!   scalar round differently),
 //! - the request as `Debug` prints it (every number to the digit that reads back exactly) and
@@ -42,7 +42,13 @@ pub fn core_version(workspace: &Path) -> Option<String> {
     let untracked = git(&["ls-files", "--others", "--exclude-standard", "--", "core"])?;
     let mut hasher = DefaultHasher::new();
     diff.hash(&mut hasher);
-    untracked.hash(&mut hasher);
+    // Untracked files by name and content (an edited one is a change too).
+    for name in String::from_utf8_lossy(&untracked).lines() {
+        name.hash(&mut hasher);
+        std::fs::read(workspace.join(name))
+            .unwrap_or_default()
+            .hash(&mut hasher);
+    }
     Some(format!(
         "{}-{:016x}",
         String::from_utf8_lossy(&tree).trim(),

@@ -53,8 +53,9 @@
 //! README).
 //!
 //! The first pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, the second
-//! three, each thread move tried two more and the one kept three more again, so a calibration is an offline job (the
-//! renderer before it renders, a background thread in the plugin), never the audio thread's.
+//! three, each thread move tried two more and the one kept three more again, so a calibration
+//! is an offline job (the renderer before it renders, a background thread in the plugin), never
+//! the audio thread's.
 //! The result is a plain number of cents and a thread move per string, which the engine adds to
 //! the string's target and thread position ([`AsPlayedTuning`]).
 
@@ -306,9 +307,10 @@ fn check<const N: usize>(
 
 /// The calibration of a string as a player sets it (module doc): the offset that centres its
 /// soft and firm plucks on the note ([`as_played_offset_cents`]) and, where those and a pluck
-/// midway lie more than [`UNSETTLED_SPREAD_CENTS`] apart at the second pass, the smallest thread move of at
-/// most ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], towards the crest first, that settles the soft,
-/// midway and firm plucks while keeping the brightness within [`BRIGHTNESS_KEPT_DB`].
+/// midway lie more than [`UNSETTLED_SPREAD_CENTS`] apart at the second pass, the smallest
+/// thread move of at most ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], towards the crest first, that
+/// settles the soft, midway and firm plucks while keeping the brightness within
+/// [`BRIGHTNESS_KEPT_DB`].
 /// Allocates and renders: off the audio thread.
 pub fn as_played_calibration(
     settings: &VoiceSettings,
