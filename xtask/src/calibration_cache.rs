@@ -1,9 +1,9 @@
 //! Calibrations kept across runs: what `cargo xtask render` and the bench's playing-range grid
 //! measured once is read back the next time instead of rendered again.
 //!
-//! A string's as-played calibration (`javari_core::tanpura::as_played`) costs 4 to 13 renders of
-//! 1.5 s on the string's own tier: at the reference tier, 8.3 s of the demo's 15.5 s on one core
-//! (stop 32). It depends only on the string's request (settings, pluck, velocities), the sample
+//! A string's as-played calibration (`javari_core::tanpura::as_played`) costs 5 renders of 1.5 s
+//! on the string's own tier, and up to 32 when its jawari is set: at the reference tier, 9.7 s
+//! of the demo's 17.3 s on one core (stop 34). It depends only on the string's request (settings, pluck, velocities), the sample
 //! rate and the code that renders it, so it is kept under `target/calibration-cache/`, one small
 //! text file per calibration, named by a hash of
 //! - the version of `core/` (its committed git tree, plus a hash of any uncommitted change to
