@@ -279,8 +279,8 @@ pub fn to_markdown(results: &[TierOverGrid]) -> String {
             text,
             "\nThe reference itself against the keys' nominal pitches (every tier is tuned as \
              played: its string's sustained pitches at velocities 40 and 110 centred on the \
-             note, and its thread moved by a fraction of a millimetre where its plucks at 40 and \
-             110 would not settle): its sustained pitch is off by {:.2} cents at worst ({}), \
+             note, and its thread moved by a fraction of a millimetre where its plucks at 40, 75 \
+             and 110 would not settle): its sustained pitch is off by {:.2} cents at worst ({}), \
              {:.2} cents median.",
             pitch.worst,
             pitch.worst_at.label(),
