@@ -188,26 +188,18 @@ fn centring_pass(
     sample_rate_hz: f64,
 ) -> f64 {
     if velocities[0] == velocities[1] {
-        check(
-            voice,
-            nominal,
-            offset_cents,
-            pluck,
-            [velocities[0]],
-            sample_rate_hz,
-        )
-        .centring_cents()
-    } else {
-        check(
-            voice,
-            nominal,
-            offset_cents,
-            pluck,
-            velocities,
-            sample_rate_hz,
-        )
-        .centring_cents()
+        let one = [velocities[0]];
+        return check(voice, nominal, offset_cents, pluck, one, sample_rate_hz).centring_cents();
     }
+    check(
+        voice,
+        nominal,
+        offset_cents,
+        pluck,
+        velocities,
+        sample_rate_hz,
+    )
+    .centring_cents()
 }
 
 /// `offset_cents`, or 0 where it is not finite or beyond [`MAX_OFFSET_CENTS`] (a string that

@@ -501,38 +501,32 @@ impl FdString {
         self.preload.fill(0.0);
         self.preloaded = false;
         let vibrating = self.config.string;
-        match self
+        let rest_stiffness = self
             .config
             .rest_bending_stiffness_n_m2
-            .filter(|&stiffness| stiffness != vibrating.bending_stiffness_n_m2)
-        {
-            Some(rest_stiffness) => {
-                // The rest state of the string with the true EI, and the preload
-                // p = g_vibrating(y_rest) − g_true(y_rest) that makes it an equilibrium of the
-                // string's own operator: g_vibrating(y_rest) − p = g_true(y_rest) = the contact
-                // force at rest.
-                self.operator.set_parameters(StringParameters {
-                    bending_stiffness_n_m2: rest_stiffness,
-                    ..vibrating
-                });
-                if !self.solve_static(&mut rest) {
-                    self.static_solve_failures += 1;
-                }
-                self.operator.restoring_force(&rest, &mut self.scratch);
-                self.operator.set_parameters(vibrating);
-                self.operator.restoring_force(&rest, &mut self.preload);
-                for (preload, true_force) in self.preload.iter_mut().zip(&self.scratch) {
-                    *preload -= true_force;
-                }
-                self.preloaded = self.preload.iter().all(|p| p.is_finite());
-                if !self.preloaded {
-                    self.preload.fill(0.0);
-                }
+            .filter(|&stiffness| stiffness != vibrating.bending_stiffness_n_m2);
+        if let Some(rest_stiffness) = rest_stiffness {
+            self.operator.set_parameters(StringParameters {
+                bending_stiffness_n_m2: rest_stiffness,
+                ..vibrating
+            });
+        }
+        if !self.solve_static(&mut rest) {
+            self.static_solve_failures += 1;
+        }
+        if rest_stiffness.is_some() {
+            // The preload p = g_vibrating(y_rest) − g_true(y_rest) makes the rest state of the
+            // true EI an equilibrium of the string's own operator: g_vibrating(y_rest) − p =
+            // g_true(y_rest) = the contact force at rest.
+            self.operator.restoring_force(&rest, &mut self.scratch);
+            self.operator.set_parameters(vibrating);
+            self.operator.restoring_force(&rest, &mut self.preload);
+            for (preload, true_force) in self.preload.iter_mut().zip(&self.scratch) {
+                *preload -= true_force;
             }
-            None => {
-                if !self.solve_static(&mut rest) {
-                    self.static_solve_failures += 1;
-                }
+            self.preloaded = self.preload.iter().all(|p| p.is_finite());
+            if !self.preloaded {
+                self.preload.fill(0.0);
             }
         }
         self.rest_nut_force_n = self.operator.nut_force_n(&rest);
