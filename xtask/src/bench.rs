@@ -966,6 +966,7 @@ pub fn to_json(
     economy: &[EconomyRow],
     keys: &[KeySpeeds],
     grid: &[TierOverGrid],
+    grid_against_refined: &[TierOverGrid],
     refinement: Option<&ReferenceRefinement>,
 ) -> String {
     let rows: Vec<String> = results
@@ -1039,12 +1040,13 @@ pub fn to_json(
     format!(
         "{{\"machine\": \"{}\", \"results\": [\n  {}\n], \"economy\": [\n  {}\n], \
          \"speed_across_keys\": [\n  {}\n], \"playing_range\": [\n  {}\n], \
-         \"reference_refinement\": {}}}\n",
+         \"playing_range_against_refined\": [\n  {}\n], \"reference_refinement\": {}}}\n",
         machine.replace('"', "'"),
         rows.join(",\n  "),
         economy_rows.join(",\n  "),
         key_rows.join(",\n  "),
         playing_range::to_json_rows(grid).join(",\n  "),
+        playing_range::to_json_rows(grid_against_refined).join(",\n  "),
         refinement
     )
 }
@@ -1127,15 +1129,18 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
         )
     };
     let refinement = run_reference_refinement(&results, seconds);
-    let grid = if no_grid {
-        Vec::new()
+    let (grid, grid_against_refined) = if no_grid {
+        (Vec::new(), Vec::new())
     } else {
         let tiers: Vec<Quality> = Quality::ALL
             .iter()
             .copied()
             .filter(|&q| q != Quality::Reference)
             .collect();
-        playing_range::measure(&tiers, SAMPLE_RATE)
+        (
+            playing_range::measure(&tiers, SAMPLE_RATE),
+            playing_range::measure_against_refined(&tiers, SAMPLE_RATE),
+        )
     };
     let mut table = String::new();
     if !results.is_empty() {
@@ -1143,6 +1148,9 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     }
     if !grid.is_empty() {
         table += &playing_range::to_markdown(&grid);
+    }
+    if !grid_against_refined.is_empty() {
+        table += &playing_range::against_refined_markdown(&grid_against_refined);
     }
     if !keys.is_empty() {
         table += &key_speeds_markdown(&keys);
@@ -1166,6 +1174,7 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
                 &economy,
                 &keys,
                 &grid,
+                &grid_against_refined,
                 refinement.as_ref(),
             ),
         )
@@ -1210,7 +1219,7 @@ mod tests {
         ));
         let table = key_speeds_markdown(std::slice::from_ref(&live));
         assert!(table.contains("| live | 88.00× (key 60) | 104.00× | 150.00× (key 36) |"));
-        let json = to_json("machine", &[], &[], &[live], &[], None);
+        let json = to_json("machine", &[], &[], &[live], &[], &[], None);
         assert!(json.contains("{\"tier\": \"live\", \"key\": 60, \"realtime_factor\": 88.000000}"));
     }
 
@@ -1241,7 +1250,7 @@ mod tests {
             "{}",
             row.spectral_distance_db
         );
-        let json = to_json("machine", &[], &[], &[], &[], Some(&refinement));
+        let json = to_json("machine", &[], &[], &[], &[], &[], Some(&refinement));
         assert!(json.contains(
             "\"reference_refinement\": {\"intervals\": 800, \"oversample\": 16, \"tiers\": \
              [{\"tier\": \"reference\""

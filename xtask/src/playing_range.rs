@@ -13,6 +13,12 @@
 //! (`javari_core::tanpura::as_played`): each tier's string at each key and pluck position is
 //! calibrated on that tier first (every calibration is kept for the next run, per version of
 //! `core/`: `crate::calibration_cache`).
+//!
+//! [`measure_against_refined`] asks the same grid how far each tier, the reference included, lies
+//! from the physics: every pluck against the reference's scheme refined fourfold in space and
+//! time (N = 800 at 16×, `javari_core::analysis::refined`), every scheme tuned by linearisation
+//! so that all are compared at equal physical parameters. The refined renders (sixteen times the
+//! reference's work) are cached like the reference's.
 
 use crate::calibration_cache::{calibration, core_version, workspace, CalibrationCache};
 use javari_core::analysis::cents;
@@ -20,6 +26,9 @@ use javari_core::analysis::listening::{compare, sustained_pitch_hz, ListeningDif
 use javari_core::analysis::playing_range::{
     calibration_request, full_grid, render_as_played, settings_for, GridPoint, KEYS, NOTE_SECONDS,
     PLUCK_POSITIONS_M,
+};
+use javari_core::analysis::refined::{
+    grid_render_linearised, grid_render_refined, YARDSTICK_REFINEMENT,
 };
 use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
@@ -74,9 +83,17 @@ impl TierOverGrid {
     }
 }
 
-fn cache_file(directory: &Path, version: &str, point: &GridPoint, sample_rate_hz: f64) -> PathBuf {
+/// The cache file of a render of `point` of the kind `render` (a label naming the scheme and its
+/// tuning).
+fn cache_file(
+    directory: &Path,
+    version: &str,
+    render: &str,
+    point: &GridPoint,
+    sample_rate_hz: f64,
+) -> PathBuf {
     let mut hasher = DefaultHasher::new();
-    "tuned as played".hash(&mut hasher);
+    render.hash(&mut hasher);
     version.hash(&mut hasher);
     format!("{:?}", settings_for(Quality::Reference, point)).hash(&mut hasher);
     point.key.hash(&mut hasher);
@@ -109,19 +126,132 @@ fn write_cached(path: &Path, output: &[f64]) {
     }
 }
 
+/// The bench's render cache: its directory and the version of `core/` (`None` without git).
+fn render_cache() -> Option<(PathBuf, String)> {
+    let workspace = workspace();
+    core_version(&workspace).map(|version| {
+        let directory = workspace.join("target/bench-cache/playing-range");
+        let _ = std::fs::create_dir_all(&directory);
+        (directory, version)
+    })
+}
+
+/// `render()` of `point`, read from `cache` when an earlier run of this version of `core/` kept
+/// it (`kind` names the scheme and its tuning), and kept there.
+fn cached_render(
+    cache: Option<&(PathBuf, String)>,
+    kind: &str,
+    point: &GridPoint,
+    sample_rate_hz: f64,
+    render: impl FnOnce() -> Vec<f64>,
+) -> Vec<f64> {
+    let samples = (NOTE_SECONDS * sample_rate_hz).round() as usize;
+    let path = cache.map(|(dir, version)| cache_file(dir, version, kind, point, sample_rate_hz));
+    if let Some(cached) = path.as_deref().and_then(|p| read_cached(p, samples)) {
+        return cached;
+    }
+    let output = render();
+    if let Some(path) = path {
+        write_cached(&path, &output);
+    }
+    output
+}
+
+/// Every pluck of the grid on the reference and on `tiers`, each against the reference's scheme
+/// refined [`YARDSTICK_REFINEMENT`] times, all tuned by linearisation (module doc). The refined
+/// renders come from the cache when there. The reference comes first.
+pub fn measure_against_refined(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
+    let grid = full_grid();
+    let cache = render_cache();
+    let kind = format!("refined {YARDSTICK_REFINEMENT} times, tuned by linearisation");
+    eprintln!(
+        "bench: playing range against N = {} at {}×, {} plucks ...",
+        200 * YARDSTICK_REFINEMENT,
+        4 * YARDSTICK_REFINEMENT,
+        grid.len()
+    );
+    let schemes: Vec<Quality> = std::iter::once(Quality::Reference)
+        .chain(tiers.iter().copied().filter(|&q| q != Quality::Reference))
+        .collect();
+    // One job per pluck: its refined render (the slow part), then every scheme against it.
+    let per_point: Vec<Vec<ListeningDifference>> = grid
+        .par_iter()
+        .map(|point| {
+            let refined = cached_render(cache.as_ref(), &kind, point, sample_rate_hz, || {
+                grid_render_refined(point, sample_rate_hz)
+            });
+            schemes
+                .iter()
+                .map(|&quality| {
+                    let render = grid_render_linearised(quality, point, sample_rate_hz, 0);
+                    compare(&render, &refined, sample_rate_hz, point.nominal_hz())
+                })
+                .collect()
+        })
+        .collect();
+    schemes
+        .iter()
+        .enumerate()
+        .map(|(s, quality)| TierOverGrid {
+            tier: quality.name(),
+            points: grid
+                .iter()
+                .zip(&per_point)
+                .map(|(point, differences)| (*point, differences[s]))
+                .collect(),
+        })
+        .collect()
+}
+
+/// The table of [`measure_against_refined`]: worst / median of each measure per scheme.
+pub fn against_refined_markdown(results: &[TierOverGrid]) -> String {
+    let mut text = format!(
+        "\nThe same plucks against the physics: every tier and the reference against the \
+         reference's scheme refined fourfold in space and time (N = {} at {}×), every scheme \
+         tuned by linearisation (equal physical parameters, no calibration as played), worst / \
+         median over the grid:\n\n\
+         | scheme | sustained pitch, cents | glide, cents | band levels, dB RMS | centroid course | worst pitch at | worst bands at |\n\
+         |---|---|---|---|---|---|---|\n",
+        200 * YARDSTICK_REFINEMENT,
+        4 * YARDSTICK_REFINEMENT,
+    );
+    for tier in results {
+        let _ = writeln!(text, "{}", spread_row(tier));
+    }
+    text
+}
+
+/// A table row: the tier, worst / median of each measure, where the worst pitch and bands lie.
+fn spread_row(tier: &TierOverGrid) -> String {
+    let (pitch, glide, bands, centroid) = (
+        tier.sustained_cents(),
+        tier.glide_cents(),
+        tier.band_level_db(),
+        tier.centroid_error(),
+    );
+    format!(
+        "| {} | {:.2} / {:.2} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} % / {:.1} % | {} | {} |",
+        tier.tier,
+        pitch.worst,
+        pitch.median,
+        glide.worst,
+        glide.median,
+        bands.worst,
+        bands.median,
+        100.0 * centroid.worst,
+        100.0 * centroid.median,
+        pitch.worst_at.label(),
+        bands.worst_at.label(),
+    )
+}
+
 /// Renders (or loads) the reference over the grid and compares `tiers` with it. The first
 /// element is the reference itself against the keys' nominal pitches: its `sustained_cents` is
 /// how far the reference sounds from the note it was tuned to (the other measures are zero).
 pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
     let grid = full_grid();
-    let workspace = workspace();
     let calibration_cache = CalibrationCache::for_workspace();
-    let cache = core_version(&workspace).map(|version| {
-        let directory = workspace.join("target/bench-cache/playing-range");
-        let _ = std::fs::create_dir_all(&directory);
-        (directory, version)
-    });
-    let samples = (NOTE_SECONDS * sample_rate_hz).round() as usize;
+    let cache = render_cache();
     eprintln!(
         "bench: playing range, {} plucks × {} tiers and the reference, on {} threads ...",
         grid.len(),
@@ -174,25 +304,21 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
                     sample_rate_hz,
                     &calibration_of(quality, point),
                 ),
-                None => {
-                    let path = cache
-                        .as_ref()
-                        .map(|(dir, version)| cache_file(dir, version, point, sample_rate_hz));
-                    if let Some(cached) = path.as_deref().and_then(|p| read_cached(p, samples)) {
-                        return cached;
-                    }
-                    let output = render_as_played(
-                        Quality::Reference,
-                        point,
-                        NOTE_SECONDS,
-                        sample_rate_hz,
-                        &calibration_of(Quality::Reference, point),
-                    );
-                    if let Some(path) = path {
-                        write_cached(&path, &output);
-                    }
-                    output
-                }
+                None => cached_render(
+                    cache.as_ref(),
+                    "tuned as played",
+                    point,
+                    sample_rate_hz,
+                    || {
+                        render_as_played(
+                            Quality::Reference,
+                            point,
+                            NOTE_SECONDS,
+                            sample_rate_hz,
+                            &calibration_of(Quality::Reference, point),
+                        )
+                    },
+                ),
             }
         })
         .collect();
@@ -251,27 +377,7 @@ pub fn to_markdown(results: &[TierOverGrid]) -> String {
         .iter()
         .filter(|t| t.tier != Quality::Reference.name())
     {
-        let (pitch, glide, bands, centroid) = (
-            tier.sustained_cents(),
-            tier.glide_cents(),
-            tier.band_level_db(),
-            tier.centroid_error(),
-        );
-        let _ = writeln!(
-            text,
-            "| {} | {:.2} / {:.2} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} % / {:.1} % | {} | {} |",
-            tier.tier,
-            pitch.worst,
-            pitch.median,
-            glide.worst,
-            glide.median,
-            bands.worst,
-            bands.median,
-            100.0 * centroid.worst,
-            100.0 * centroid.median,
-            pitch.worst_at.label(),
-            bands.worst_at.label(),
-        );
+        let _ = writeln!(text, "{}", spread_row(tier));
     }
     if let Some(reference) = results.iter().find(|t| t.tier == Quality::Reference.name()) {
         let pitch = reference.sustained_cents();
@@ -351,4 +457,47 @@ pub fn to_json_rows(results: &[TierOverGrid]) -> Vec<String> {
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(key: u8, velocity: u8) -> GridPoint {
+        GridPoint {
+            key,
+            velocity,
+            pluck_position_m: 0.20,
+        }
+    }
+
+    fn difference(cents: f64, band_level_db: f64) -> ListeningDifference {
+        ListeningDifference {
+            sustained_cents: cents,
+            glide_cents: cents.abs(),
+            band_level_db,
+            centroid_error: 0.1,
+        }
+    }
+
+    #[test]
+    fn the_table_against_the_physics_has_a_row_per_scheme_the_reference_first() {
+        let scheme = |tier, worst_cents: f64| TierOverGrid {
+            tier,
+            points: vec![
+                (point(51, 127), difference(-worst_cents, 5.4)),
+                (point(60, 127), difference(0.2, 13.1)),
+                (point(36, 1), difference(0.0, 0.6)),
+            ],
+        };
+        let table = against_refined_markdown(&[scheme("reference", 16.53), scheme("live", 2.26)]);
+        let reference = table.find("| reference | 16.53 / 0.20 |").expect(&table);
+        let live = table.find("| live | 2.26 / 0.20 |").expect(&table);
+        assert!(reference < live);
+        assert!(table.contains("N = 800 at 16×"));
+        assert!(table.contains(
+            "| 13.1 / 5.4 | 10.0 % / 10.0 % | key 51, velocity 127, pluck at 0.20 m | key 60, \
+             velocity 127, pluck at 0.20 m |"
+        ));
+    }
 }

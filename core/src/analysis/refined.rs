@@ -16,7 +16,15 @@
 //! [`modal_pluck`] builds a modal tier's string as the voice builds it (`VoiceSettings::
 //! modal_config_at`, f32 modes), tunes it by the same passes, plucks it and picks it up as the
 //! voice does; with the voice's sample rate and no residual modes it is the voice's output.
+//!
+//! **The playing-range grid against the physics.** [`grid_render_refined`] renders a pluck of
+//! the bench's grid on the reference's string refined [`YARDSTICK_REFINEMENT`] times (N = 800
+//! at 16×, which N = 1600 at 32× moves by 1.8–4.2 dB and 2–9 % on the grid's measures at keys
+//! 51–60, where the seed's grid lies 5–14 dB and 7–89 % from it), and [`grid_render_linearised`]
+//! the same pluck on a tier's voice; both tuned by linearisation, so that the schemes are compared
+//! at equal physical parameters (`docs/modal-tanpura.md` section 9, "Stop 35").
 
+use crate::analysis::playing_range::{calibration_request, GridPoint, NOTE_SECONDS};
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::fd::decimator::render_decimated;
 use crate::tanpura::fd::FdString;
@@ -24,7 +32,7 @@ use crate::tanpura::modal::ModalString;
 use crate::tanpura::quality::Quality;
 use crate::tanpura::tier_string::weighted_pickup_n;
 use crate::tanpura::voice::tune_tension;
-use crate::tanpura::VoiceSettings;
+use crate::tanpura::{TanpuraVoice, VoiceSettings};
 
 /// A render of [`refined_reference_pluck`]: the grid it ran on and its output at the output rate.
 #[derive(Debug, Clone)]
@@ -121,4 +129,61 @@ pub fn modal_pluck(
             })
             .collect(),
     )
+}
+
+/// The refinement of the bench's physical yardstick: N = 800 at 16×.
+pub const YARDSTICK_REFINEMENT: usize = 4;
+
+/// The string settings of `point` on `quality` as the engine plans them (its note's pitch, the
+/// instrument's bridge, thread and losses) and its pluck at the point's velocity.
+pub fn grid_pluck(quality: Quality, point: &GridPoint) -> (VoiceSettings, Pluck) {
+    let request = calibration_request(quality, point.key, point.pluck_position_m);
+    let pluck = Pluck {
+        amplitude_m: request.pluck.amplitude_m * f64::from(point.velocity) / 127.0,
+        ..request.pluck
+    };
+    (request.settings, pluck)
+}
+
+/// [`NOTE_SECONDS`] of `point` on a fresh voice of `quality` tuned by linearisation (the voice's
+/// output, without the engine's output gain); a modal tier with `residual_modes` residual modes
+/// through [`modal_pluck`] (with none it is the voice's output bit for bit).
+pub fn grid_render_linearised(
+    quality: Quality,
+    point: &GridPoint,
+    sample_rate_hz: f64,
+    residual_modes: usize,
+) -> Vec<f64> {
+    let (settings, pluck) = grid_pluck(quality, point);
+    if residual_modes > 0 {
+        if let Some(output) = modal_pluck(
+            &settings,
+            sample_rate_hz,
+            residual_modes,
+            &pluck,
+            NOTE_SECONDS,
+        ) {
+            return output;
+        }
+    }
+    let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
+    voice.pluck(&pluck);
+    (0..(NOTE_SECONDS * sample_rate_hz).round() as usize)
+        .map(|_| f64::from(voice.next_sample()))
+        .collect()
+}
+
+/// [`NOTE_SECONDS`] of `point` on the reference's string refined [`YARDSTICK_REFINEMENT`] times,
+/// tuned by linearisation (empty if the tuning finds no fundamental). Sixteen times the
+/// reference tier's work: offline.
+pub fn grid_render_refined(point: &GridPoint, sample_rate_hz: f64) -> Vec<f64> {
+    let (settings, pluck) = grid_pluck(Quality::Reference, point);
+    refined_reference_pluck(
+        &settings,
+        YARDSTICK_REFINEMENT,
+        &pluck,
+        NOTE_SECONDS,
+        sample_rate_hz,
+    )
+    .map_or_else(Vec::new, |render| render.output)
 }

@@ -1,0 +1,153 @@
+//! Every tier and the reference itself against the reference's scheme refined fourfold in space
+//! and time (N = 800 at 16×, `analysis::refined`), over the bench's playing-range grid:
+//! `cargo run --release -p javari-core --example grid_against_refined [POSITIONS_M]
+//! [--residual-modes N]` (positions such as `0.2,0.35`, default both; the modal tiers with N
+//! residual modes, default none as the tiers run; the whole grid takes about three minutes on two
+//! cores, almost all of it the refined renders). `cargo xtask bench` measures the same without
+//! the residual modes, and caches the refined renders.
+//!
+//! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
+//! tier tuned by linearising about its own rest state (no calibration as played), so that the
+//! schemes are compared at equal physical parameters; the refined string is tuned and plucked
+//! the same way. The four measures are the bench's (`analysis::listening::compare`). The figures
+//! are quoted in `docs/modal-tanpura.md`, section 9 ("Stop 35").
+
+use javari_core::analysis::listening::{compare, ListeningDifference};
+use javari_core::analysis::playing_range::{full_grid, GridPoint};
+use javari_core::analysis::refined::{grid_render_linearised, grid_render_refined};
+use javari_core::tanpura::quality::Quality;
+
+const SAMPLE_RATE_HZ: f64 = 44_100.0;
+const TIERS: [Quality; 4] = [
+    Quality::Reference,
+    Quality::Studio,
+    Quality::Live,
+    Quality::Draft,
+];
+
+/// Each tier's distance from the refined render of `point`, in the order of [`TIERS`].
+fn measure(point: &GridPoint, residual_modes: usize) -> Vec<ListeningDifference> {
+    let refined = grid_render_refined(point, SAMPLE_RATE_HZ);
+    TIERS
+        .iter()
+        .map(|&quality| {
+            let output = grid_render_linearised(quality, point, SAMPLE_RATE_HZ, residual_modes);
+            compare(&output, &refined, SAMPLE_RATE_HZ, point.nominal_hz())
+        })
+        .collect()
+}
+
+/// `--residual-modes N`: the modal tiers with N residual modes (`docs/modal-tanpura.md` §8).
+fn residual_modes(args: &[String]) -> usize {
+    args.iter()
+        .position(|arg| arg == "--residual-modes")
+        .map_or(0, |at| {
+            args.get(at + 1)
+                .and_then(|n| n.parse().ok())
+                .expect("--residual-modes takes a count")
+        })
+}
+
+/// The upper median, as the bench takes it.
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[values.len() / 2]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let residual_modes = residual_modes(&args);
+    let positions: Option<Vec<f64>> =
+        args.get(1)
+            .filter(|arg| !arg.starts_with("--"))
+            .map(|list| {
+                list.split(',')
+                    .map(|p| p.parse().expect("positions in metres, such as 0.2,0.35"))
+                    .collect()
+            });
+    let points: Vec<GridPoint> = full_grid()
+        .into_iter()
+        .filter(|point| {
+            positions.as_ref().is_none_or(|list| {
+                list.iter()
+                    .any(|p| (p - point.pluck_position_m).abs() < 1e-9)
+            })
+        })
+        .collect();
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut results: Vec<(usize, Vec<ListeningDifference>)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut mine = Vec::new();
+                    loop {
+                        let index = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(point) = points.get(index) else {
+                            break mine;
+                        };
+                        mine.push((index, measure(point, residual_modes)));
+                    }
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|handle| handle.join().expect("a worker panicked"))
+            .collect()
+    });
+    results.sort_by_key(|(index, _)| *index);
+
+    println!(
+        "Against N = 800 at 16× (cents, band levels dB, centroid %), tuned by linearisation, \
+         modal tiers with {residual_modes} residual modes:"
+    );
+    print!("{:<36}", "pluck");
+    for quality in TIERS {
+        print!(" | {:^20}", quality.name());
+    }
+    println!();
+    for (index, differences) in &results {
+        print!("{:<36}", points[*index].label());
+        for difference in differences {
+            print!(
+                " | {:6.2} {:5.1} {:6.1}",
+                difference.sustained_cents,
+                difference.band_level_db,
+                100.0 * difference.centroid_error
+            );
+        }
+        println!();
+    }
+    println!("\nWorst / median over {} plucks:", results.len());
+    for (tier, quality) in TIERS.iter().enumerate() {
+        let column = |measure: fn(&ListeningDifference) -> f64| -> Vec<f64> {
+            results
+                .iter()
+                .map(|(_, differences)| measure(&differences[tier]))
+                .collect()
+        };
+        let summary = |values: Vec<f64>| {
+            let worst = values.iter().copied().fold(0.0, f64::max);
+            (worst, median(values))
+        };
+        let pitch = summary(column(|d| d.sustained_cents.abs()));
+        let bands = summary(column(|d| d.band_level_db));
+        let centroid = summary(column(|d| 100.0 * d.centroid_error));
+        let nearer = results
+            .iter()
+            .filter(|(_, d)| d[tier].band_level_db < d[0].band_level_db)
+            .count();
+        println!(
+            "{:<9} pitch {:6.2} / {:4.2} cents, band levels {:5.1} / {:4.1} dB, centroid {:5.1} / \
+             {:4.1} %; band levels nearer than the reference's at {nearer} plucks",
+            quality.name(),
+            pitch.0,
+            pitch.1,
+            bands.0,
+            bands.1,
+            centroid.0,
+            centroid.1,
+        );
+    }
+}
