@@ -361,3 +361,63 @@ fn modal_voice_blocks_equal_its_samples() {
         assert!(blocks.iter().any(|&bits| f32::from_bits(bits) != 0.0));
     }
 }
+
+/// The residual modes' shapes at the points make `Σ_j ψ_j(x_a) ψ_j(x_b)` the best rank-J part of
+/// the truncated modes' compliance `R = C − Ψ_K Ψ_Kᵀ` (`docs/modal-tanpura.md` section 8): the
+/// retune's subspace iteration gives what the whole decomposition of R gives, for one to four
+/// residual modes at the live tier's points.
+#[test]
+fn residual_mode_shapes_are_the_leading_part_of_the_truncated_compliance() {
+    use javari_core::dense::symmetric_eigen_jacobi;
+    use javari_core::tanpura::modal::modes::MODE_CAPACITY;
+    for residual_modes in 1..=4 {
+        let config = ModalStringConfig {
+            residual_modes,
+            bridge_point_spacing_m: 2e-3,
+            ..ModalStringConfig::REFERENCE
+        };
+        let string = ModalString::<f32>::new(config);
+        let (modes, points) = (string.modes(), string.points());
+        let positions = string.point_positions_m();
+        let size = positions.len();
+        let rows: Vec<Vec<f64>> = positions
+            .iter()
+            .map(|&x| {
+                let mut row = vec![0.0; MODE_CAPACITY];
+                modes.shape_row(x, &mut row);
+                row
+            })
+            .collect();
+        let mut truncated = vec![0.0; size * size];
+        for a in 0..size {
+            for b in 0..size {
+                truncated[a * size + b] =
+                    modes.residual_compliance_m_n(positions[a], positions[b], &rows[a], &rows[b]);
+            }
+        }
+        let mut vectors = vec![0.0; size * size];
+        symmetric_eigen_jacobi(&mut truncated, &mut vectors, size, size);
+        let mut order: Vec<usize> = (0..size).collect();
+        order.sort_by(|&a, &b| truncated[b * size + b].total_cmp(&truncated[a * size + a]));
+        let largest = truncated[order[0] * size + order[0]];
+        let (kept, count) = (modes.kept(), modes.count());
+        assert_eq!(count - kept, residual_modes);
+        for a in 0..size {
+            for b in 0..size {
+                let leading: f64 = order[..residual_modes]
+                    .iter()
+                    .map(|&e| {
+                        truncated[e * size + e] * vectors[a * size + e] * vectors[b * size + e]
+                    })
+                    .sum();
+                let shaped: f64 = (kept..count)
+                    .map(|k| points.shape(a)[k] * points.shape(b)[k])
+                    .sum();
+                assert!(
+                    (leading - shaped).abs() <= 1e-10 * largest,
+                    "{residual_modes} modes, points {a}, {b}: {leading:e} against {shaped:e}"
+                );
+            }
+        }
+    }
+}

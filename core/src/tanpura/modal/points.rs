@@ -13,7 +13,7 @@
 
 use super::lanes::{padded_lanes, Kernels};
 use super::modes::{ModeSet, MODE_CAPACITY};
-use crate::dense::symmetric_eigen_jacobi;
+use crate::dense::{leading_eigenpairs, symmetric_eigen_jacobi, LEADING_BLOCK_CAPACITY};
 use crate::tanpura::contact::HuntCrossley;
 use crate::tanpura::geometry::{BridgeSettings, ThreadSettings};
 
@@ -53,6 +53,8 @@ pub struct ContactPoints {
     /// its eigenvectors (`capacity × capacity`).
     eigen_matrix: Vec<f64>,
     eigen_vectors: Vec<f64>,
+    /// Subspace iteration's block and its image ([`leading_eigenpairs`]).
+    eigen_work: Vec<f64>,
 }
 
 /// Points of a grid covering `[start, end]` with the given spacing (at least one).
@@ -86,6 +88,7 @@ impl ContactPoints {
             kept_row: zeros(capacity),
             eigen_matrix: zeros(capacity * capacity),
             eigen_vectors: zeros(capacity * capacity),
+            eigen_work: zeros(2 * capacity * LEADING_BLOCK_CAPACITY),
         }
     }
 
@@ -272,6 +275,28 @@ impl ContactPoints {
                 self.eigen_matrix[j * stride + i] = residual;
             }
         }
+        // The leading pairs by subspace iteration (a few hundred short dot products; columns of
+        // `eigen_vectors` in rank order, values in `coupling_row`).
+        if leading_eigenpairs(
+            &self.eigen_matrix,
+            count,
+            stride,
+            modes.count() - kept,
+            &mut self.coupling_row,
+            &mut self.eigen_vectors,
+            &mut self.eigen_work,
+        ) {
+            for (rank, mode) in (kept..modes.count()).enumerate() {
+                let scale = self.coupling_row[rank].max(0.0).sqrt();
+                for i in 0..count {
+                    self.shapes[i * MODE_CAPACITY + mode] =
+                        scale * self.eigen_vectors[i * stride + rank];
+                }
+            }
+            return;
+        }
+        // Where that does not apply (more residual modes than the block holds or the points
+        // allow) or does not converge: the whole decomposition.
         symmetric_eigen_jacobi(
             &mut self.eigen_matrix,
             &mut self.eigen_vectors,
