@@ -14,7 +14,7 @@
 
 use javari_core::analysis::listening::{compare, ListeningDifference};
 use javari_core::analysis::playing_range::{full_grid, GridPoint};
-use javari_core::analysis::refined::{grid_render_linearised, grid_render_refined};
+use javari_core::analysis::refined::{grid_render_linearised, grid_render_refined, yardstick_grid};
 use javari_core::tanpura::quality::Quality;
 
 const SAMPLE_RATE_HZ: f64 = 44_100.0;
@@ -98,9 +98,10 @@ fn main() {
     });
     results.sort_by_key(|(index, _)| *index);
 
+    let (intervals, oversample) = yardstick_grid();
     println!(
-        "Against N = 800 at 16× (cents, band levels dB, centroid %), tuned by linearisation, \
-         modal tiers with {residual_modes} residual modes:"
+        "Against N = {intervals} at {oversample}× (cents, band levels dB, centroid %), tuned by \
+         linearisation, modal tiers with {residual_modes} residual modes:"
     );
     print!("{:<36}", "pluck");
     for quality in TIERS {

@@ -28,7 +28,7 @@ use javari_core::analysis::playing_range::{
     PLUCK_POSITIONS_M,
 };
 use javari_core::analysis::refined::{
-    grid_render_linearised, grid_render_refined, YARDSTICK_REFINEMENT,
+    grid_render_linearised, grid_render_refined, yardstick_grid, YARDSTICK_REFINEMENT,
 };
 use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
@@ -164,10 +164,9 @@ pub fn measure_against_refined(tiers: &[Quality], sample_rate_hz: f64) -> Vec<Ti
     let grid = full_grid();
     let cache = render_cache();
     let kind = format!("refined {YARDSTICK_REFINEMENT} times, tuned by linearisation");
+    let (intervals, oversample) = yardstick_grid();
     eprintln!(
-        "bench: playing range against N = {} at {}×, {} plucks ...",
-        200 * YARDSTICK_REFINEMENT,
-        4 * YARDSTICK_REFINEMENT,
+        "bench: playing range against N = {intervals} at {oversample}×, {} plucks ...",
         grid.len()
     );
     let schemes: Vec<Quality> = std::iter::once(Quality::Reference)
@@ -205,15 +204,14 @@ pub fn measure_against_refined(tiers: &[Quality], sample_rate_hz: f64) -> Vec<Ti
 
 /// The table of [`measure_against_refined`]: worst / median of each measure per scheme.
 pub fn against_refined_markdown(results: &[TierOverGrid]) -> String {
+    let (intervals, oversample) = yardstick_grid();
     let mut text = format!(
         "\nThe same plucks against the physics: every tier and the reference against the \
-         reference's scheme refined fourfold in space and time (N = {} at {}×), every scheme \
+         reference's scheme refined fourfold in space and time (N = {intervals} at {oversample}×), every scheme \
          tuned by linearisation (equal physical parameters, no calibration as played), worst / \
          median over the grid:\n\n\
          | scheme | sustained pitch, cents | glide, cents | band levels, dB RMS | centroid course | worst pitch at | worst bands at |\n\
-         |---|---|---|---|---|---|---|\n",
-        200 * YARDSTICK_REFINEMENT,
-        4 * YARDSTICK_REFINEMENT,
+         |---|---|---|---|---|---|---|\n"
     );
     for tier in results {
         let _ = writeln!(text, "{}", spread_row(tier));

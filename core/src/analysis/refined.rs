@@ -134,6 +134,17 @@ pub fn modal_pluck(
 /// The refinement of the bench's physical yardstick: N = 800 at 16×.
 pub const YARDSTICK_REFINEMENT: usize = 4;
 
+/// The yardstick's grid: its intervals and its oversampling of the output rate.
+pub fn yardstick_grid() -> (usize, usize) {
+    let tier = Quality::Reference
+        .fd_tier()
+        .expect("the reference tier is an FD tier");
+    (
+        tier.intervals * YARDSTICK_REFINEMENT,
+        tier.oversample * YARDSTICK_REFINEMENT,
+    )
+}
+
 /// The string settings of `point` on `quality` as the engine plans them (its note's pitch, the
 /// instrument's bridge, thread and losses) and its pluck at the point's velocity.
 pub fn grid_pluck(quality: Quality, point: &GridPoint) -> (VoiceSettings, Pluck) {
