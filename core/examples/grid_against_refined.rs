@@ -3,7 +3,8 @@
 //! `cargo run --release -p javari-core --example grid_against_refined [POSITIONS_M]
 //! [--residual-modes N]` (positions such as `0.2,0.35`, default both; the modal tiers with N
 //! residual modes, default none as the tiers run; the whole grid takes about three minutes on two
-//! cores, almost all of it the refined renders). `cargo xtask bench` measures the same without
+//! cores, almost all of it the refined renders). `-- --yardstick-check` asks instead how far the
+//! yardstick moves when refined twice more, at six plucks. `cargo xtask bench` measures the same without
 //! the residual modes, and caches the refined renders.
 //!
 //! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
@@ -14,7 +15,10 @@
 
 use javari_core::analysis::listening::{compare, ListeningDifference};
 use javari_core::analysis::playing_range::{full_grid, GridPoint};
-use javari_core::analysis::refined::{grid_render_linearised, grid_render_refined, yardstick_grid};
+use javari_core::analysis::refined::{
+    grid_pluck, grid_render_linearised, grid_render_refined, refined_reference_pluck,
+    yardstick_grid, YARDSTICK_REFINEMENT,
+};
 use javari_core::tanpura::quality::Quality;
 
 const SAMPLE_RATE_HZ: f64 = 44_100.0;
@@ -54,8 +58,65 @@ fn median(mut values: Vec<f64>) -> f64 {
     values[values.len() / 2]
 }
 
+/// `--yardstick-check`: how far the yardstick itself moves when refined twice more (N = 1600 at
+/// 32×), at keys 51, 57 and 60, velocities 40 and 127, plucked at 0.20 m (about a minute and a
+/// half on two cores).
+fn yardstick_check() {
+    let points: Vec<GridPoint> = [51, 57, 60]
+        .into_iter()
+        .flat_map(|key| {
+            [40, 127].map(|velocity| GridPoint {
+                key,
+                velocity,
+                pluck_position_m: 0.20,
+            })
+        })
+        .collect();
+    let (intervals, oversample) = yardstick_grid();
+    println!(
+        "N = {intervals} at {oversample}× against N = {} at {}× (cents, band levels dB, centroid %):",
+        2 * intervals,
+        2 * oversample
+    );
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = points
+            .iter()
+            .map(|point| {
+                scope.spawn(move || {
+                    let (settings, pluck) = grid_pluck(Quality::Reference, point);
+                    let finer = refined_reference_pluck(
+                        &settings,
+                        2 * YARDSTICK_REFINEMENT,
+                        &pluck,
+                        javari_core::analysis::playing_range::NOTE_SECONDS,
+                        SAMPLE_RATE_HZ,
+                    )
+                    .expect("the reference tier is an FD tier")
+                    .output;
+                    let yardstick = grid_render_refined(point, SAMPLE_RATE_HZ);
+                    compare(&yardstick, &finer, SAMPLE_RATE_HZ, point.nominal_hz())
+                })
+            })
+            .collect();
+        for (point, handle) in points.iter().zip(handles) {
+            let d = handle.join().expect("a worker panicked");
+            println!(
+                "{:<36} {:6.2} {:5.1} {:6.1}",
+                point.label(),
+                d.sustained_cents,
+                d.band_level_db,
+                100.0 * d.centroid_error
+            );
+        }
+    });
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if args.iter().any(|arg| arg == "--yardstick-check") {
+        yardstick_check();
+        return;
+    }
     let residual_modes = residual_modes(&args);
     let positions: Option<Vec<f64>> =
         args.get(1)
