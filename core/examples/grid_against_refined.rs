@@ -4,7 +4,10 @@
 //! [--residual-modes N]` (positions such as `0.2,0.35`, default both; the modal tiers with N
 //! residual modes, default none as the tiers run; the whole grid takes about three minutes on two
 //! cores, almost all of it the refined renders). `-- --yardstick-check` asks instead how far the
-//! yardstick moves when refined twice more, at six plucks. `cargo xtask bench` measures the same without
+//! yardstick moves when refined twice more, at six plucks; `-- --space-time KEY VELOCITY
+//! POSITION_M` how far the seed's scheme lies from it at one pluck on grids refined in space or
+//! in time alone; `-- --live-variants KEY VELOCITY POSITION_M` the live tier's string with a
+//! shorter time step or other bridge points. `cargo xtask bench` measures the same without
 //! the residual modes, and caches the refined renders.
 //!
 //! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
@@ -16,8 +19,9 @@
 use javari_core::analysis::listening::{compare, ListeningDifference};
 use javari_core::analysis::playing_range::{full_grid, GridPoint};
 use javari_core::analysis::refined::{
-    grid_pluck, grid_render_linearised, grid_render_refined, refined_reference_pluck,
-    yardstick_grid, YARDSTICK_REFINEMENT,
+    grid_pluck, grid_render_linearised, grid_render_refined, modal_variant_pluck,
+    reference_pluck_on_grid, refined_reference_pluck, yardstick_grid, ModalVariant,
+    YARDSTICK_REFINEMENT,
 };
 use javari_core::tanpura::quality::Quality;
 
@@ -111,10 +115,164 @@ fn yardstick_check() {
     });
 }
 
+/// `--space-time KEY VELOCITY POSITION_M [GRIDS]`: one pluck of the grid on the seed's scheme
+/// on other grids (GRIDS such as `200x4,400x2`, N intervals at an oversampling; default N = 200
+/// and 400 at 2×, 4×, 8× and 16×, N = 300 and 400 at 3× and N = 800 at 4×) against the yardstick,
+/// with each render's wall time (one at a time): whether the reference's distance from it is
+/// spatial or temporal (`docs/modal-tanpura.md` §9, "Stop 35").
+fn space_time(args: &[String]) {
+    let at = args
+        .iter()
+        .position(|arg| arg == "--space-time")
+        .expect("called with --space-time");
+    let number = |offset: usize, what: &str| -> f64 {
+        args.get(at + offset)
+            .and_then(|value| value.parse().ok())
+            .unwrap_or_else(|| panic!("--space-time KEY VELOCITY POSITION_M: {what} missing"))
+    };
+    let point = GridPoint {
+        key: number(1, "key") as u8,
+        velocity: number(2, "velocity") as u8,
+        pluck_position_m: number(3, "pluck position"),
+    };
+    let grids: Vec<(usize, usize)> = match args.get(at + 4) {
+        Some(list) => list
+            .split(',')
+            .map(|grid| {
+                grid.split_once('x')
+                    .and_then(|(n, o)| Some((n.parse().ok()?, o.parse().ok()?)))
+                    .expect("grids such as 200x4,400x2")
+            })
+            .collect(),
+        None => [200, 400]
+            .into_iter()
+            .flat_map(|intervals| [2, 4, 8, 16].map(|oversample| (intervals, oversample)))
+            .chain([(300, 3), (400, 3), (800, 4)])
+            .collect(),
+    };
+    let (intervals, oversample) = yardstick_grid();
+    println!(
+        "{} on the seed's scheme against N = {intervals} at {oversample}× (cents, band levels dB, centroid %, render s), tuned by linearisation:",
+        point.label()
+    );
+    let yardstick = grid_render_refined(&point, SAMPLE_RATE_HZ);
+    let (settings, pluck) = grid_pluck(Quality::Reference, &point);
+    for (intervals, oversample) in grids {
+        let started = std::time::Instant::now();
+        let output = reference_pluck_on_grid(
+            &settings,
+            intervals,
+            oversample,
+            &pluck,
+            javari_core::analysis::playing_range::NOTE_SECONDS,
+            SAMPLE_RATE_HZ,
+        )
+        .expect("the reference tier is an FD tier")
+        .output;
+        let seconds = started.elapsed().as_secs_f64();
+        let d = compare(&output, &yardstick, SAMPLE_RATE_HZ, point.nominal_hz());
+        println!(
+            "N = {intervals:<4} at {oversample:>2}×  {:6.2} {:5.1} {:6.1} {seconds:6.2}",
+            d.sustained_cents,
+            d.band_level_db,
+            100.0 * d.centroid_error
+        );
+    }
+}
+
+/// `--live-variants KEY VELOCITY POSITION_M`: one pluck of the grid on the live tier's string as
+/// it is, run at 2× and 4× the output rate and decimated, and with the bridge's points every 1,
+/// 0.5 and 0.25 mm, against the reference tier and against the yardstick, all tuned by
+/// linearisation: whether the live tier's distance from the reference comes from its time step
+/// or its bridge points (`docs/modal-tanpura.md` §9, "Stop 35").
+fn live_variants(args: &[String]) {
+    let at = args
+        .iter()
+        .position(|arg| arg == "--live-variants")
+        .expect("called with --live-variants");
+    let number = |offset: usize, what: &str| -> f64 {
+        args.get(at + offset)
+            .and_then(|value| value.parse().ok())
+            .unwrap_or_else(|| panic!("--live-variants KEY VELOCITY POSITION_M: {what} missing"))
+    };
+    let point = GridPoint {
+        key: number(1, "key") as u8,
+        velocity: number(2, "velocity") as u8,
+        pluck_position_m: number(3, "pluck position"),
+    };
+    let variants = [
+        ("the live tier", ModalVariant::default()),
+        (
+            "at 2× the output rate",
+            ModalVariant {
+                oversample: 2,
+                ..ModalVariant::default()
+            },
+        ),
+        (
+            "at 4× the output rate",
+            ModalVariant {
+                oversample: 4,
+                ..ModalVariant::default()
+            },
+        ),
+    ]
+    .into_iter()
+    .chain(
+        [
+            ("bridge points every 1 mm", 1.0e-3),
+            ("every 0.5 mm", 0.5e-3),
+            ("every 0.25 mm", 0.25e-3),
+        ]
+        .map(|(name, spacing_m)| {
+            let variant = ModalVariant {
+                bridge_point_spacing_m: Some(spacing_m),
+                ..ModalVariant::default()
+            };
+            (name, variant)
+        }),
+    );
+    let reference = grid_render_linearised(Quality::Reference, &point, SAMPLE_RATE_HZ, 0);
+    let yardstick = grid_render_refined(&point, SAMPLE_RATE_HZ);
+    let (settings, pluck) = grid_pluck(Quality::Live, &point);
+    println!(
+        "{}, tuned by linearisation: against the reference tier | against the yardstick (cents, band levels dB, centroid %)",
+        point.label()
+    );
+    for (name, variant) in variants {
+        let output = modal_variant_pluck(
+            &settings,
+            &variant,
+            &pluck,
+            javari_core::analysis::playing_range::NOTE_SECONDS,
+            SAMPLE_RATE_HZ,
+        )
+        .expect("the live tier is modal");
+        let row = |against: &[f64]| {
+            let d = compare(&output, against, SAMPLE_RATE_HZ, point.nominal_hz());
+            format!(
+                "{:6.2} {:5.1} {:6.1}",
+                d.sustained_cents,
+                d.band_level_db,
+                100.0 * d.centroid_error
+            )
+        };
+        println!("{name:<26} {} | {}", row(&reference), row(&yardstick));
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.iter().any(|arg| arg == "--yardstick-check") {
         yardstick_check();
+        return;
+    }
+    if args.iter().any(|arg| arg == "--space-time") {
+        space_time(&args);
+        return;
+    }
+    if args.iter().any(|arg| arg == "--live-variants") {
+        live_variants(&args);
         return;
     }
     let residual_modes = residual_modes(&args);

@@ -260,3 +260,55 @@ fn a_string_bistable_between_agreeing_ends_gets_its_jawari_set() {
         calibration.thread_offset_m * 1e3
     );
 }
+
+/// One jawari for the instrument (issue 15; `as_played.rs`, *One jawari for the instrument*):
+/// the studio tier's string rests where the reference's rests, and its calibration takes the
+/// reference's thread move. Set on its own scheme, the studio's jawari for key 54 plucked at
+/// 0.20 m lay a step (0.05 mm) from the reference's, and its softest touch stayed on the crest
+/// where the reference's lifted off: 14.8 cents apart.
+#[test]
+fn the_studio_plays_the_jawari_the_reference_sets() {
+    let mut settings = settings();
+    settings.pluck.position_m = 0.20;
+    let key = 54u8;
+    let target = settings.tuning.note_hz(key);
+    let heard = |quality: Quality| {
+        let mut settings = settings;
+        settings.voice.quality = quality;
+        let calibration = calibrate(&settings, &[key])[0];
+        let mut engine = Engine::new(&settings, SAMPLE_RATE, 1);
+        engine.set_calibration(&calibration);
+        let pitches = [1u8, 127].map(|velocity| {
+            engine.reset();
+            let signal = render(&mut engine, key, f32::from(velocity) / 127.0);
+            cents(sustained_pitch_hz(&signal, SAMPLE_RATE, target), target)
+        });
+        (calibration.thread_offset_m, pitches)
+    };
+    let (studio, reference) = std::thread::scope(|scope| {
+        let studio = scope.spawn(|| heard(Quality::Studio));
+        let reference = heard(Quality::Reference);
+        (
+            studio.join().expect("the studio's calibration panicked"),
+            reference,
+        )
+    });
+    assert!(
+        reference.0 != 0.0,
+        "the reference's jawari was not set: the case this test is about is gone"
+    );
+    assert!(
+        (studio.0 - reference.0).abs() < 1e-12,
+        "thread moved by {:+.3} mm (studio) and {:+.3} mm (reference)",
+        studio.0 * 1e3,
+        reference.0 * 1e3
+    );
+    for (index, velocity) in [1, 127].into_iter().enumerate() {
+        assert!(
+            (studio.1[index] - reference.1[index]).abs() <= 1.0,
+            "velocity {velocity}: studio {:.2} cents, reference {:.2} cents",
+            studio.1[index],
+            reference.1[index]
+        );
+    }
+}

@@ -168,14 +168,20 @@ impl CalibrationCache {
     }
 }
 
-/// [`CalibrationCache::get_or_measure`] through `cache` when there is one, else measured.
+/// [`CalibrationCache::get_or_measure`] through `cache` when there is one, else measured. The
+/// calibration of the string whose jawari this one takes (the studio tier's: the reference's)
+/// goes through `cache` too.
 pub fn calibration(
     cache: Option<&CalibrationCache>,
     request: &CalibrationRequest,
     sample_rate_hz: f64,
 ) -> (Calibration, Source) {
     match cache {
-        Some(cache) => cache.get_or_measure(request, sample_rate_hz, Calibration::measure),
+        Some(cache) => cache.get_or_measure(request, sample_rate_hz, |request, rate| {
+            Calibration::measure_with(request, rate, |jawari, rate| {
+                calibration(Some(cache), jawari, rate).0
+            })
+        }),
         None => (
             Calibration::measure(request, sample_rate_hz),
             Source::Measured,

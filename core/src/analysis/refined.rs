@@ -16,6 +16,9 @@
 //! [`modal_pluck`] builds a modal tier's string as the voice builds it (`VoiceSettings::
 //! modal_config_at`, f32 modes), tunes it by the same passes, plucks it and picks it up as the
 //! voice does; with the voice's sample rate and no residual modes it is the voice's output.
+//! [`modal_variant_pluck`] does the same for a string that departs from its tier's in its time
+//! step or its bridge points ([`ModalVariant`]), to rule those out as causes of the tier's
+//! distance from the reference.
 //!
 //! **The playing-range grid against the physics.** [`grid_render_refined`] renders a pluck of
 //! the bench's grid on the reference's string refined [`YARDSTICK_REFINEMENT`] times (N = 800
@@ -54,7 +57,28 @@ pub fn refined_reference_pluck(
 ) -> Option<RefinedRender> {
     let tier = Quality::Reference.fd_tier()?;
     let refinement = refinement.max(1);
-    let (intervals, oversample) = (tier.intervals * refinement, tier.oversample * refinement);
+    reference_pluck_on_grid(
+        settings,
+        tier.intervals * refinement,
+        tier.oversample * refinement,
+        pluck,
+        seconds,
+        sample_rate_hz,
+    )
+}
+
+/// [`refined_reference_pluck`] on any grid of the seed's scheme: `intervals` along the string
+/// and `oversample` times `sample_rate_hz` (each at least 1; the barrier's points as the
+/// reference's), to tell the grid's spatial error from its temporal one.
+pub fn reference_pluck_on_grid(
+    settings: &VoiceSettings,
+    intervals: usize,
+    oversample: usize,
+    pluck: &Pluck,
+    seconds: f64,
+    sample_rate_hz: f64,
+) -> Option<RefinedRender> {
+    let (intervals, oversample) = (intervals.max(1), oversample.max(1));
     let mut config = settings.fd_config_at(Quality::Reference, sample_rate_hz)?;
     config.intervals = intervals;
     config.time_step_s = 1.0 / (sample_rate_hz * oversample as f64);
@@ -100,8 +124,51 @@ pub fn modal_pluck(
     pluck: &Pluck,
     seconds: f64,
 ) -> Option<Vec<f64>> {
-    let mut config = settings.modal_config_at(settings.quality, sample_rate_hz)?;
-    config.residual_modes = residual_modes;
+    let variant = ModalVariant {
+        residual_modes,
+        ..ModalVariant::default()
+    };
+    modal_variant_pluck(settings, &variant, pluck, seconds, sample_rate_hz)
+}
+
+/// How [`modal_variant_pluck`]'s string departs from its tier's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModalVariant {
+    /// Residual modes (`docs/modal-tanpura.md` §8); the tiers have none.
+    pub residual_modes: usize,
+    /// Steps per output sample, through the FD tiers' decimator; the tiers take one.
+    pub oversample: usize,
+    /// The bridge's points every this many metres instead of the tier's spacing.
+    pub bridge_point_spacing_m: Option<f64>,
+}
+
+impl Default for ModalVariant {
+    fn default() -> Self {
+        Self {
+            residual_modes: 0,
+            oversample: 1,
+            bridge_point_spacing_m: None,
+        }
+    }
+}
+
+/// [`modal_pluck`] with the string of `variant`: residual modes, a shorter time step (the string
+/// run at `oversample` times `sample_rate_hz`, keeping the tier's highest mode, then decimated) or
+/// other bridge points. With the default variant it is [`modal_pluck`] without residual modes.
+pub fn modal_variant_pluck(
+    settings: &VoiceSettings,
+    variant: &ModalVariant,
+    pluck: &Pluck,
+    seconds: f64,
+    sample_rate_hz: f64,
+) -> Option<Vec<f64>> {
+    let oversample = variant.oversample.max(1);
+    let mut config =
+        settings.modal_config_at(settings.quality, sample_rate_hz * oversample as f64)?;
+    config.residual_modes = variant.residual_modes;
+    if let Some(spacing_m) = variant.bridge_point_spacing_m {
+        config.bridge_point_spacing_m = spacing_m;
+    }
     let mut string = ModalString::<f32>::new(config);
     tune_tension(
         &mut string,
@@ -115,20 +182,21 @@ pub fn modal_pluck(
     )?;
     string.pluck(pluck);
     let samples = (seconds * sample_rate_hz) as usize;
-    Some(
-        (0..samples)
-            .map(|_| {
-                string.step();
-                let pickup = weighted_pickup_n(
-                    settings.nut_pickup_weight,
-                    string.nut_force_change_n(),
-                    string.bridge_force_change_n(),
-                );
-                // The voice's output is f32.
-                f64::from(pickup as f32)
-            })
-            .collect(),
-    )
+    let mut next = || {
+        string.step();
+        weighted_pickup_n(
+            settings.nut_pickup_weight,
+            string.nut_force_change_n(),
+            string.bridge_force_change_n(),
+        )
+    };
+    let output = if oversample == 1 {
+        (0..samples).map(|_| next()).collect()
+    } else {
+        render_decimated(oversample, samples, next)
+    };
+    // The voice's output is f32.
+    Some(output.into_iter().map(|x| f64::from(x as f32)).collect())
 }
 
 /// The refinement of the bench's physical yardstick: N = 800 at 16×.

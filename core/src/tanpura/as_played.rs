@@ -52,14 +52,30 @@
 //! also settle them but takes 6–13 dB off their level above 2 kHz (`examples/jawari_moves.rs`,
 //! README).
 //!
+//! **One jawari for the instrument.** The thread's position is a setting of the instrument,
+//! not of the scheme that simulates it: a musician who plays in one tier and renders in another
+//! has set the jawari once. The studio tier's string rests exactly where the reference's rests
+//! (the FD rest preload, `fd/mod.rs`), so its jawari is set on the reference's scheme
+//! ([`jawari_set_on`]): the studio's calibration takes the reference's thread move for the same
+//! string and pluck and centres its own tension on it ([`as_played_with_jawari`]). Set on its
+//! own scheme it could differ by a step: at key 54 plucked at 0.20 m the window of bistable
+//! thread positions lies a fraction of a step apart in the two schemes, the studio settled at
+//! +0.25 mm and the reference at +0.30 mm, and the softest touch (velocity 1) then stayed on the
+//! crest in one and not in the other, 14.8 cents apart; at +0.30 mm both lie within 0.12 cents of
+//! each other at every velocity 1–127 (`examples/as_played.rs`). The modal tiers keep their
+//! own: their string rests 7 µm above the crest (`docs/modal-tanpura.md` §8), so the reference's
+//! thread would not set the same contact on it.
+//!
 //! The first pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, the second
 //! three, each thread move tried two more and the one kept three more again, so a calibration
 //! is an offline job (the renderer before it renders, a background thread in the plugin), never
-//! the audio thread's.
+//! the audio thread's. The studio's costs the reference's calibration and four renders of its
+//! own.
 //! The result is a plain number of cents and a thread move per string, which the engine adds to
 //! the string's target and thread position ([`AsPlayedTuning`]).
 
 use super::excitation::Pluck;
+use super::quality::Quality;
 use super::voice::{TanpuraVoice, VoiceSettings};
 use crate::analysis::listening::{sustained_pitch_hz, SUSTAIN_WINDOW_S};
 use crate::analysis::{band_power, power_spectrum};
@@ -303,6 +319,8 @@ fn check<const N: usize>(
 /// thread move of at most ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], towards the crest first, that
 /// settles the soft, midway and firm plucks while keeping the brightness within
 /// [`BRIGHTNESS_KEPT_DB`].
+/// A tier whose jawari is set on another's ([`jawari_set_on`]) takes that tier's thread move
+/// and is centred on its own ([`as_played_with_jawari`]).
 /// Allocates and renders: off the audio thread.
 pub fn as_played_calibration(
     settings: &VoiceSettings,
@@ -317,6 +335,25 @@ pub fn as_played_calibration(
             offset_cents: as_played_offset_cents(&settings, pluck, velocities, sample_rate_hz),
             thread_offset_m: 0.0,
         };
+    }
+    let jawari_tier = jawari_set_on(settings.quality);
+    if jawari_tier != settings.quality {
+        let jawari = as_played_calibration(
+            &VoiceSettings {
+                quality: jawari_tier,
+                ..settings
+            },
+            pluck,
+            velocities,
+            sample_rate_hz,
+        );
+        return as_played_with_jawari(
+            &settings,
+            pluck,
+            velocities,
+            sample_rate_hz,
+            jawari.thread_offset_m,
+        );
     }
     let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
     // The two passes of [`as_played_offset_cents`] (the same renders and the same offset), the
@@ -400,6 +437,42 @@ pub fn as_played_calibration(
     unmoved
 }
 
+/// The tier on whose scheme a string of `quality` has its jawari set (module doc, *One jawari
+/// for the instrument*): the studio tier's on the reference's, every other tier's on its own.
+pub fn jawari_set_on(quality: Quality) -> Quality {
+    match quality {
+        Quality::Studio => Quality::Reference,
+        other => other,
+    }
+}
+
+/// The calibration of a string whose jawari is set elsewhere: its thread moved by
+/// `thread_offset_m` (clamped to the thread's range), then centred on its own tier by the two
+/// passes of [`as_played_offset_cents`]. Allocates and renders: off the audio thread.
+pub fn as_played_with_jawari(
+    settings: &VoiceSettings,
+    pluck: &Pluck,
+    velocities: [f64; 2],
+    sample_rate_hz: f64,
+    thread_offset_m: f64,
+) -> AsPlayed {
+    let settings = settings.clamped();
+    let thread_offset_m = if thread_offset_m.is_finite() {
+        thread_offset_m
+    } else {
+        0.0
+    };
+    let moved = VoiceSettings {
+        thread_position_m: settings.thread_position_m + thread_offset_m,
+        ..settings
+    }
+    .clamped();
+    AsPlayed {
+        offset_cents: as_played_offset_cents(&moved, pluck, velocities, sample_rate_hz),
+        thread_offset_m: moved.thread_position_m - settings.thread_position_m,
+    }
+}
+
 /// What to calibrate: a string, the pluck it is played with at full velocity, and the soft and
 /// firm ends of its velocities (fractions of full).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -411,6 +484,21 @@ pub struct CalibrationRequest {
 }
 
 impl CalibrationRequest {
+    /// The same string on the tier its jawari is set on ([`jawari_set_on`]), where that is
+    /// another tier and the string is played at more than one strength (one played at one
+    /// strength is only centred).
+    pub fn jawari_request(&self) -> Option<Self> {
+        let quality = jawari_set_on(self.settings.quality);
+        let played_at_one_strength = self.velocities[0] == self.velocities[1];
+        (quality != self.settings.quality && !played_at_one_strength).then_some(Self {
+            settings: VoiceSettings {
+                quality,
+                ..self.settings
+            },
+            ..*self
+        })
+    }
+
     /// The request as it is measured: settings and pluck clamped to their ranges, velocities to
     /// [0, 1] (a NaN velocity taken as full).
     pub fn clamped(&self) -> Self {
@@ -446,13 +534,32 @@ pub struct Calibration {
 impl Calibration {
     /// Measures the calibration of a string (renders: off the audio thread).
     pub fn measure(request: &CalibrationRequest, sample_rate_hz: f64) -> Self {
+        Self::measure_with(request, sample_rate_hz, Self::measure)
+    }
+
+    /// [`Calibration::measure`], with the calibration of the string whose jawari this one takes
+    /// ([`CalibrationRequest::jawari_request`]) from `jawari` (a cache of calibrations, say).
+    pub fn measure_with(
+        request: &CalibrationRequest,
+        sample_rate_hz: f64,
+        jawari: impl FnOnce(&CalibrationRequest, f64) -> Calibration,
+    ) -> Self {
         let request = request.clamped();
-        let as_played = as_played_calibration(
-            &request.settings,
-            &request.pluck,
-            request.velocities,
-            sample_rate_hz,
-        );
+        let as_played = match request.jawari_request() {
+            Some(jawari_request) => as_played_with_jawari(
+                &request.settings,
+                &request.pluck,
+                request.velocities,
+                sample_rate_hz,
+                jawari(&jawari_request, sample_rate_hz).thread_offset_m,
+            ),
+            None => as_played_calibration(
+                &request.settings,
+                &request.pluck,
+                request.velocities,
+                sample_rate_hz,
+            ),
+        };
         Self {
             request,
             sample_rate_hz,
@@ -594,7 +701,6 @@ impl AsPlayedTuning {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tanpura::quality::Quality;
 
     /// Stop 32's calibration read the note from the voice's settings, which each render leaves at
     /// its own target: the check of a moved thread then rendered the string tuned by the
