@@ -3,7 +3,9 @@
 //! the audio thread cannot afford, so the audio thread hands the strings it plucks without a
 //! current calibration to this thread and takes the measured calibrations back at the start of a
 //! later block. A string plays with its linearised tuning (or the last calibration of its note)
-//! until then: about a second after the first pluck of a new note at the live tier.
+//! until then: about a second after the first pluck of a new note at the live tier, several at
+//! the studio tier, whose calibration takes the reference's jawari and so measures the
+//! reference's calibration first (`as_played::jawari_set_on`).
 //!
 //! Both directions are lock-free fixed-size queues (`crossbeam::queue::ArrayQueue`): the audio
 //! thread only pushes and pops, never waits, locks or allocates (a full queue drops the request;
@@ -78,17 +80,7 @@ fn run(shared: &Shared) {
             std::thread::sleep(POLL_INTERVAL);
             continue;
         };
-        let calibration = match remembered.iter().find(|known| known.is_for(&request, rate)) {
-            Some(known) => *known,
-            None => {
-                let measured = Calibration::measure(&request, rate);
-                if remembered.len() == REMEMBERED {
-                    remembered.remove(0);
-                }
-                remembered.push(measured);
-                measured
-            }
-        };
+        let calibration = recall_or_measure(&mut remembered, &request, rate);
         // The audio thread empties the queue every block; if it is full, wait for it.
         while shared.results.push(calibration).is_err() {
             if shared.stop.load(Ordering::Relaxed) {
@@ -97,6 +89,27 @@ fn run(shared: &Shared) {
             std::thread::sleep(POLL_INTERVAL);
         }
     }
+}
+
+/// The calibration of `request` from `remembered`, else measured and remembered (the oldest
+/// forgotten beyond [`REMEMBERED`]); the calibration whose jawari it takes (a studio string's:
+/// the reference's) the same way, so that a note switched between those tiers is measured once.
+fn recall_or_measure(
+    remembered: &mut Vec<Calibration>,
+    request: &CalibrationRequest,
+    rate: f64,
+) -> Calibration {
+    if let Some(known) = remembered.iter().find(|known| known.is_for(request, rate)) {
+        return *known;
+    }
+    let measured = Calibration::measure_with(request, rate, |jawari, rate| {
+        recall_or_measure(remembered, jawari, rate)
+    });
+    if remembered.len() == REMEMBERED {
+        remembered.remove(0);
+    }
+    remembered.push(measured);
+    measured
 }
 
 #[cfg(test)]
@@ -126,5 +139,27 @@ mod tests {
         assert!(calibration.offset_cents.is_finite());
         // A3 at the live tier settles without the jawari set.
         assert_eq!(calibration.thread_offset_m, 0.0);
+    }
+
+    #[test]
+    fn a_studio_calibration_remembers_the_reference_it_takes_the_jawari_from() {
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = Quality::Studio;
+        let request = Engine::planned_strings(&settings, &[57])[0];
+        let reference = request
+            .jawari_request()
+            .expect("a studio string takes the reference's jawari");
+        let rate = 44_100.0;
+        let mut remembered = Vec::new();
+        let studio = recall_or_measure(&mut remembered, &request, rate);
+        assert_eq!(remembered.len(), 2, "the studio's and the reference's");
+        assert!(remembered
+            .iter()
+            .any(|known| known.is_for(&reference, rate)));
+        assert!(studio.is_for(&request, rate));
+        // Switched to the reference tier, the note is not measured again.
+        let recalled = recall_or_measure(&mut remembered, &reference, rate);
+        assert_eq!(remembered.len(), 2);
+        assert_eq!(recalled.thread_offset_m, studio.thread_offset_m);
     }
 }
