@@ -115,26 +115,33 @@ fn yardstick_check() {
     });
 }
 
-/// `--space-time KEY VELOCITY POSITION_M [GRIDS]`: one pluck of the grid on the seed's scheme
-/// on other grids (GRIDS such as `200x4,400x2`, N intervals at an oversampling; default N = 200
-/// and 400 at 2×, 4×, 8× and 16×, N = 300 and 400 at 3× and N = 800 at 4×) against the yardstick,
-/// with each render's wall time (one at a time): whether the reference's distance from it is
-/// spatial or temporal (`docs/modal-tanpura.md` §9, "Stop 35").
-fn space_time(args: &[String]) {
+/// The pluck named by the three arguments after `flag` (KEY VELOCITY POSITION_M), and where
+/// `flag` stands.
+fn pluck_after(args: &[String], flag: &str) -> (usize, GridPoint) {
     let at = args
         .iter()
-        .position(|arg| arg == "--space-time")
-        .expect("called with --space-time");
+        .position(|arg| arg == flag)
+        .unwrap_or_else(|| panic!("called without {flag}"));
     let number = |offset: usize, what: &str| -> f64 {
         args.get(at + offset)
             .and_then(|value| value.parse().ok())
-            .unwrap_or_else(|| panic!("--space-time KEY VELOCITY POSITION_M: {what} missing"))
+            .unwrap_or_else(|| panic!("{flag} KEY VELOCITY POSITION_M: {what} missing"))
     };
     let point = GridPoint {
         key: number(1, "key") as u8,
         velocity: number(2, "velocity") as u8,
         pluck_position_m: number(3, "pluck position"),
     };
+    (at, point)
+}
+
+/// `--space-time KEY VELOCITY POSITION_M [GRIDS]`: one pluck of the grid on the seed's scheme
+/// on other grids (GRIDS such as `200x4,400x2`, N intervals at an oversampling; default N = 200
+/// and 400 at 2×, 4×, 8× and 16×, N = 300 and 400 at 3× and N = 800 at 4×) against the yardstick,
+/// with each render's wall time (one at a time): whether the reference's distance from it is
+/// spatial or temporal (`docs/modal-tanpura.md` §9, "Stop 35").
+fn space_time(args: &[String]) {
+    let (at, point) = pluck_after(args, "--space-time");
     let grids: Vec<(usize, usize)> = match args.get(at + 4) {
         Some(list) => list
             .split(',')
@@ -186,20 +193,7 @@ fn space_time(args: &[String]) {
 /// linearisation: whether the live tier's distance from the reference comes from its time step
 /// or its bridge points (`docs/modal-tanpura.md` §9, "Stop 35").
 fn live_variants(args: &[String]) {
-    let at = args
-        .iter()
-        .position(|arg| arg == "--live-variants")
-        .expect("called with --live-variants");
-    let number = |offset: usize, what: &str| -> f64 {
-        args.get(at + offset)
-            .and_then(|value| value.parse().ok())
-            .unwrap_or_else(|| panic!("--live-variants KEY VELOCITY POSITION_M: {what} missing"))
-    };
-    let point = GridPoint {
-        key: number(1, "key") as u8,
-        velocity: number(2, "velocity") as u8,
-        pluck_position_m: number(3, "pluck position"),
-    };
+    let (_, point) = pluck_after(args, "--live-variants");
     let variants = [
         ("the live tier", ModalVariant::default()),
         (
