@@ -10,7 +10,7 @@
 use javari_core::analysis::cents;
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::tanpura::as_played::{
-    as_played_calibration, sustained_pitch_of_pluck_hz, NOTE_VELOCITIES,
+    sustained_pitch_of_pluck_hz, Calibration, CalibrationRequest, NOTE_VELOCITIES,
 };
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
@@ -82,8 +82,15 @@ fn main() {
                         thread_position_m,
                         ..VoiceSettings::default()
                     };
-                    let as_played =
-                        as_played_calibration(&settings, pluck, NOTE_VELOCITIES, SAMPLE_RATE);
+                    // As the engine measures it: the studio with the reference's jawari.
+                    let as_played = Calibration::measure(
+                        &CalibrationRequest {
+                            settings,
+                            pluck: *pluck,
+                            velocities: NOTE_VELOCITIES,
+                        },
+                        SAMPLE_RATE,
+                    );
                     let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
                     let linearised = row(&mut voice, pluck, key, 0.0);
                     voice.set_settings(&VoiceSettings {

@@ -319,8 +319,8 @@ fn check<const N: usize>(
 /// thread move of at most ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], towards the crest first, that
 /// settles the soft, midway and firm plucks while keeping the brightness within
 /// [`BRIGHTNESS_KEPT_DB`].
-/// A tier whose jawari is set on another's ([`jawari_set_on`]) takes that tier's thread move
-/// and is centred on its own ([`as_played_with_jawari`]).
+/// This searches the string's own tier; [`Calibration::measure`] gives a tier whose jawari is
+/// set on another's ([`jawari_set_on`]) that tier's thread move instead.
 /// Allocates and renders: off the audio thread.
 pub fn as_played_calibration(
     settings: &VoiceSettings,
@@ -335,25 +335,6 @@ pub fn as_played_calibration(
             offset_cents: as_played_offset_cents(&settings, pluck, velocities, sample_rate_hz),
             thread_offset_m: 0.0,
         };
-    }
-    let jawari_tier = jawari_set_on(settings.quality);
-    if jawari_tier != settings.quality {
-        let jawari = as_played_calibration(
-            &VoiceSettings {
-                quality: jawari_tier,
-                ..settings
-            },
-            pluck,
-            velocities,
-            sample_rate_hz,
-        );
-        return as_played_with_jawari(
-            &settings,
-            pluck,
-            velocities,
-            sample_rate_hz,
-            jawari.thread_offset_m,
-        );
     }
     let mut voice = TanpuraVoice::new(&settings, sample_rate_hz);
     // The two passes of [`as_played_offset_cents`] (the same renders and the same offset), the
@@ -532,7 +513,10 @@ pub struct Calibration {
 }
 
 impl Calibration {
-    /// Measures the calibration of a string (renders: off the audio thread).
+    /// Measures the calibration of a string (renders: off the audio thread): its own tier's
+    /// [`as_played_calibration`], or, for a tier whose jawari is set on another's
+    /// ([`jawari_set_on`]), that tier's thread move with its own tension centred on it
+    /// ([`as_played_with_jawari`]).
     pub fn measure(request: &CalibrationRequest, sample_rate_hz: f64) -> Self {
         Self::measure_with(request, sample_rate_hz, Self::measure)
     }
