@@ -204,15 +204,17 @@ fn reference_notes_at_the_crest_settle_with_the_thread_moved_as_a_player_sets_it
     });
 }
 
-/// A string can be bistable between ends that agree: the studio tier's key 54 plucked at
+/// A string can be bistable between ends that agree: the reference tier's key 54 plucked at
 /// 0.20 m, centred by its soft and firm plucks alone, has them within
 /// [`UNSETTLED_SPREAD_CENTS`] of each other while a pluck midway sounds more than 2 cents off
-/// the note. The calibration checks that pluck too, and sets the jawari.
+/// the note. The calibration checks that pluck too, and sets the jawari. (The studio tier at
+/// 2× oversampling was bistable there too; at 3× its ends alone lie 5.1 cents apart, and its
+/// jawari is the reference's.)
 #[test]
 fn a_string_bistable_between_agreeing_ends_gets_its_jawari_set() {
     use javari_core::tanpura::as_played::UNSETTLED_SPREAD_CENTS;
     let mut settings = settings();
-    settings.voice.quality = Quality::Studio;
+    settings.voice.quality = Quality::Reference;
     settings.pluck.position_m = 0.20;
     let key = 54u8;
     let calibration = calibrate(&settings, &[key])[0];
