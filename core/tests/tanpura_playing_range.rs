@@ -9,7 +9,8 @@
 //! live tier's sustained pitch agrees within about 2.3 cents (the modal string rests on the
 //! thread only where the reference also rests on the crest; `docs/modal-tanpura.md` §8); this
 //! test fails if that, or its band levels, or the reference's own tuning, parts. The studio
-//! tier, which shares the reference's rest state, is held to it at two of those keys too.
+//! tier, which shares the reference's rest state, is held to it at two of those keys too, and
+//! at key 54 plucked hardest, where its band levels lay furthest from the reference's.
 
 use javari_core::analysis::cents;
 use javari_core::analysis::listening::{compare, sustained_pitch_hz, ListeningDifference};
@@ -100,5 +101,18 @@ fn the_live_tier_sounds_like_the_reference_across_the_range() {
 fn the_studio_tier_sounds_like_the_reference_at_the_crest_keys() {
     for (point, difference, _) in against_the_reference(Quality::Studio, &[49, 50]) {
         assert_within(&point, &difference, 1.0, 5.0);
+    }
+}
+
+/// The studio tier's hardest pluck at key 54 was the playing range's worst in band levels while
+/// the studio stepped at 2× the output rate (5.80 dB from the reference in the bench's grid,
+/// tuned as played; over the tier's 5 dB target); at 3× it lies within it (4.90 dB). Here, with
+/// the linearised tuning: 5.76 dB at 2×, 4.96 dB at 3×. The bench holds the 5 dB target; this
+/// test holds the pluck below 5.4 dB, halfway between the two steps, so that another vector
+/// unit's rounding cannot decide it and a return to 2× fails it.
+#[test]
+fn the_studio_tiers_hardest_pluck_keeps_the_references_band_levels() {
+    for (point, difference, _) in against_the_reference(Quality::Studio, &[54]) {
+        assert_within(&point, &difference, 1.0, 5.4);
     }
 }
