@@ -10,9 +10,11 @@
 //! linearised tuning, every tier's partials and the seed's scheme's at N = 400 (8×) against
 //! N = 800 (16×, `analysis::refined`), at the scene's pluck (velocity 127) and barely plucked
 //! (velocity 1), with the live tier's string with two residual modes (`docs/modal-tanpura.md`,
-//! section 8) at the output rate and at two and four times it.
+//! section 8) at the output rate and at two and four times it. `-- bridge=1mm` sets those
+//! residual-mode rows' bridge points 1 mm apart (the live tier's until stop 29) instead of the
+//! tier's 2 mm.
 
-use javari_core::analysis::refined::{modal_pluck, refined_reference_pluck};
+use javari_core::analysis::refined::{modal_variant_pluck, refined_reference_pluck, ModalVariant};
 use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::tanpura::as_played::{
     as_played_offset_cents, sustained_pitch_of_pluck_hz, NOTE_VELOCITIES,
@@ -87,8 +89,22 @@ fn render_at(quality: Quality, tuning: Tuning, velocity: f64) -> (f64, Vec<f64>)
     (offset, output)
 }
 
+/// The bridge point spacing of the residual-mode rows, from an argument `bridge=<mm>mm`, or the
+/// tier's.
+fn bridge_point_spacing_m() -> Option<f64> {
+    std::env::args().skip(1).find_map(|argument| {
+        let millimetres = argument.strip_prefix("bridge=")?.strip_suffix("mm")?;
+        let spacing: f64 = millimetres
+            .parse()
+            .unwrap_or_else(|_| panic!("`{argument}`: expected bridge=<millimetres>mm"));
+        assert!(spacing > 0.0, "`{argument}`: the spacing must be positive");
+        Some(spacing * 1e-3)
+    })
+}
+
 fn main() {
     let nominal_hz = VoiceSettings::default().fundamental_hz;
+    let bridge_point_spacing_m = bridge_point_spacing_m();
     println!("sustained pitch (0.3-1.5 s), linearised tuning, cents from the note, velocities 1 40 80 110 127");
     for quality in Quality::ALL.into_iter().rev() {
         let settings = VoiceSettings {
@@ -182,7 +198,12 @@ fn main() {
         for residual_modes in [0, 2] {
             for rate_factor in [1.0, 2.0, 4.0] {
                 let rate = SAMPLE_RATE * rate_factor;
-                let output = modal_pluck(&live, rate, residual_modes, &pluck, SECONDS)
+                let variant = ModalVariant {
+                    residual_modes,
+                    bridge_point_spacing_m,
+                    ..ModalVariant::default()
+                };
+                let output = modal_variant_pluck(&live, &variant, &pluck, SECONDS, rate)
                     .expect("the live tier is modal");
                 println!(
                     "  live, {residual_modes} residual modes, {rate_factor}x rate | {}",
