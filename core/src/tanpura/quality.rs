@@ -18,8 +18,8 @@
 //!   seed's grids. At 2× its hard plucks' band levels lay up to 5.8 dB from the reference's over
 //!   the playing range; at 3× 4.9 dB, within the 5 dB the tier is held to, for 1.33–1.41 times
 //!   the cost (README, stop 37). Studio's EI is raised so that its inharmonicity matches the
-//!   reference's (`voice.rs`, `dispersion_compensated_stiffness`), for the vibration only: its string rests
-//!   where the reference's rests (the FD rest preload, `fd/mod.rs`).
+//!   reference's (`voice.rs`, `dispersion_compensated_stiffness`), for the vibration only: its
+//!   string rests where the reference's rests (the FD rest preload, `fd/mod.rs`).
 //!
 //! Every tier keeps its scheme's exact discrete energy balance; the balance holds only for a
 //! converged Newton: a tolerance of 1e-8 m let an FD tier's energy grow by 0.3 % per step at
