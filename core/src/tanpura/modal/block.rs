@@ -16,7 +16,7 @@
 //!
 //! Hand-written rather than on a linear-algebra crate for the reasons of `step.rs`.
 
-use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed, sub_product};
+use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
 use crate::tanpura::contact::HuntCrossley;
 
 /// The lanes of the fixed path: one AVX-512 register of f64, two AVX2 registers.
@@ -263,9 +263,9 @@ impl<const N: usize> BlockState<N> {
 
     /// Newton's iteration from the current steps, at most `max_iterations` updates, stopping
     /// as `ContactStep::newton` does; then the forces at the accepted step. Returns (updates,
-    /// converged). `FUSED`: the arithmetic of [`sub_product`].
+    /// converged).
     #[inline(always)]
-    pub fn newton<const FUSED: bool>(
+    pub fn newton(
         &mut self,
         block: &Block<N>,
         tolerance_m: f64,
@@ -277,8 +277,7 @@ impl<const N: usize> BlockState<N> {
             self.evaluate();
             let (crossing, crossing_slot) = self.crossing_points();
             let linear = crossing == 0;
-            let (largest, exact) =
-                self.update::<FUSED>(block, (crossing == 1).then_some(crossing_slot));
+            let (largest, exact) = self.update(block, (crossing == 1).then_some(crossing_slot));
             if !largest.is_finite() {
                 outcome = (iteration, false);
                 break;
@@ -300,7 +299,7 @@ impl<const N: usize> BlockState<N> {
     /// for the evaluation point's contact cases, taken if it lies in them
     /// (`ContactStep::update`).
     #[inline(always)]
-    fn update<const FUSED: bool>(&mut self, block: &Block<N>, crossing: Option<usize>) -> Update {
+    fn update(&mut self, block: &Block<N>, crossing: Option<usize>) -> Update {
         // R = Δu − Δu_free − G ΔF; a point with no force change adds an exact zero.
         let mut residual = [0.0; N];
         for lane in 0..N {
@@ -308,7 +307,7 @@ impl<const N: usize> BlockState<N> {
         }
         for (row, &change) in block.iter().zip(&self.changes) {
             for lane in 0..N {
-                residual[lane] = sub_product::<FUSED>(residual[lane], row[lane], change);
+                residual[lane] -= row[lane] * change;
             }
         }
         // A: the points with c > 0, and D = diag(√c) on them.
@@ -336,15 +335,15 @@ impl<const N: usize> BlockState<N> {
         let mut crossing_weights = [0.0; N];
         let finite = match size {
             0 => true,
-            1 => system.solve::<1, FUSED>(&residual, &mut weights, &mut crossing_weights),
-            2 => system.solve::<2, FUSED>(&residual, &mut weights, &mut crossing_weights),
-            3 => system.solve::<3, FUSED>(&residual, &mut weights, &mut crossing_weights),
-            4 => system.solve::<4, FUSED>(&residual, &mut weights, &mut crossing_weights),
-            5 => system.solve::<5, FUSED>(&residual, &mut weights, &mut crossing_weights),
-            6 => system.solve::<6, FUSED>(&residual, &mut weights, &mut crossing_weights),
-            7 => system.solve::<7, FUSED>(&residual, &mut weights, &mut crossing_weights),
-            8 => system.solve::<8, FUSED>(&residual, &mut weights, &mut crossing_weights),
-            _ => system.solve_any::<FUSED>(size, &residual, &mut weights),
+            1 => system.solve::<1>(&residual, &mut weights, &mut crossing_weights),
+            2 => system.solve::<2>(&residual, &mut weights, &mut crossing_weights),
+            3 => system.solve::<3>(&residual, &mut weights, &mut crossing_weights),
+            4 => system.solve::<4>(&residual, &mut weights, &mut crossing_weights),
+            5 => system.solve::<5>(&residual, &mut weights, &mut crossing_weights),
+            6 => system.solve::<6>(&residual, &mut weights, &mut crossing_weights),
+            7 => system.solve::<7>(&residual, &mut weights, &mut crossing_weights),
+            8 => system.solve::<8>(&residual, &mut weights, &mut crossing_weights),
+            _ => system.solve_any(size, &residual, &mut weights),
         };
         // δ = −R − G_{:,A} D y.
         let mut deltas = [0.0; N];
@@ -353,12 +352,11 @@ impl<const N: usize> BlockState<N> {
         }
         for (row, &weight) in block.iter().zip(&weights) {
             for lane in 0..N {
-                deltas[lane] = sub_product::<FUSED>(deltas[lane], row[lane], weight);
+                deltas[lane] -= row[lane] * weight;
             }
         }
         if let Some(crossing) = crossing {
-            if let Some(largest) =
-                self.finish_exactly::<FUSED>(block, crossing, &deltas, &crossing_weights)
+            if let Some(largest) = self.finish_exactly(block, crossing, &deltas, &crossing_weights)
             {
                 return (largest, true);
             }
@@ -382,7 +380,7 @@ impl<const N: usize> BlockState<N> {
     /// had). Replaces the steps and returns the largest change if every other point then lies in
     /// the case it was evaluated in.
     #[inline(always)]
-    fn finish_exactly<const FUSED: bool>(
+    fn finish_exactly(
         &mut self,
         block: &Block<N>,
         crossing: usize,
@@ -393,7 +391,7 @@ impl<const N: usize> BlockState<N> {
         let mut direction = block[crossing];
         for (row, &weight) in block.iter().zip(crossing_weights) {
             for lane in 0..N {
-                direction[lane] = sub_product::<FUSED>(direction[lane], row[lane], weight);
+                direction[lane] -= row[lane] * weight;
             }
         }
         let gap = self.gaps[crossing];
@@ -445,7 +443,7 @@ impl<const N: usize> Active<'_, N> {
     /// into `crossing_weights`; returns whether `D y` is finite
     /// (`ContactStep::solve_active_fixed`).
     #[inline(always)]
-    fn solve<const SIZE: usize, const FUSED: bool>(
+    fn solve<const SIZE: usize>(
         &self,
         residual: &Lanes<N>,
         weights: &mut Lanes<N>,
@@ -462,8 +460,8 @@ impl<const N: usize> Active<'_, N> {
             matrix[a][a] += 1.0;
             y[a] = -roots[a] * residual[active[a]];
         }
-        ldl_factor_fixed::<SIZE, FUSED>(&mut matrix);
-        ldl_substitute_fixed::<SIZE, FUSED>(&matrix, &mut y);
+        ldl_factor_fixed(&mut matrix);
+        ldl_substitute_fixed(&matrix, &mut y);
         let mut finite = true;
         for a in 0..SIZE {
             let weight = y[a] * roots[a];
@@ -476,7 +474,7 @@ impl<const N: usize> Active<'_, N> {
             for a in 0..SIZE {
                 second[a] = roots[a] * column[active[a]];
             }
-            ldl_substitute_fixed::<SIZE, FUSED>(&matrix, &mut second);
+            ldl_substitute_fixed(&matrix, &mut second);
             for a in 0..SIZE {
                 crossing_weights[active[a]] = second[a] * roots[a];
             }
@@ -487,12 +485,7 @@ impl<const N: usize> Active<'_, N> {
     /// [`Active::solve`] for more than [`FIXED_SOLVE`] active points, by the general path's
     /// loops (`ContactStep::solve_active_any`, the same arithmetic), with no crossing finish.
     #[inline(always)]
-    fn solve_any<const FUSED: bool>(
-        &self,
-        size: usize,
-        residual: &Lanes<N>,
-        weights: &mut Lanes<N>,
-    ) -> bool {
+    fn solve_any(&self, size: usize, residual: &Lanes<N>, weights: &mut Lanes<N>) -> bool {
         let (block, active, roots) = (self.block, self.active, self.roots);
         let mut matrix = [0.0; WIDE_BLOCK * WIDE_BLOCK];
         let (mut y, mut scratch) = ([0.0; WIDE_BLOCK], [0.0; WIDE_BLOCK]);
@@ -505,7 +498,7 @@ impl<const N: usize> Active<'_, N> {
             matrix[a * size + a] += 1.0;
             y[a] = -roots[a] * residual[active[a]];
         }
-        ldl_solve_in_place::<FUSED>(matrix, size, &mut y[..size], &mut scratch[..size]);
+        ldl_solve_in_place(matrix, size, &mut y[..size], &mut scratch[..size]);
         let mut finite = true;
         for a in 0..size {
             let weight = y[a] * roots[a];

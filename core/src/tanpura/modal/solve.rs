@@ -22,56 +22,32 @@ use super::modes::MODE_CAPACITY;
 use super::points::ContactPoints;
 use crate::dense::DenseCholesky;
 
-/// `c − a b` as the contact solve forms it: one rounding (a fused multiply-add) when `FUSED`,
-/// two otherwise. The step passes `FUSED` on every vector unit it is dispatched to (x86-64-v3
-/// and v4 have FMA, as NEON does): the residual, the update and the factorisation are chains of
-/// these, and fused each link is one instruction instead of two (`docs/performance.md`, "Stop
-/// 38"). Not on the scalar fallback, where a fused multiply-add is a call into libm
-/// (`ContactStep::step`).
-#[inline(always)]
-pub(super) fn sub_product<const FUSED: bool>(c: f64, a: f64, b: f64) -> f64 {
-    if FUSED {
-        (-a).mul_add(b, c)
-    } else {
-        c - a * b
-    }
-}
-
 /// Solves `A x = b` in place for the SPD `n × n` matrix whose lower triangle is in `matrix`
 /// (row-major), by an LDLᵀ factorisation written over it: `L` below the diagonal, `D` on it. No
 /// pivoting and no square roots: the tracked solve's matrices have eigenvalues ≥ 1. `scratch`
-/// holds `L_jk d_k` for the row being factorised. The arithmetic, in its order, is that of
-/// [`ldl_factor_fixed`] and [`ldl_substitute_fixed`].
-pub(super) fn ldl_solve_in_place<const FUSED: bool>(
-    matrix: &mut [f64],
-    n: usize,
-    x: &mut [f64],
-    scratch: &mut [f64],
-) {
+/// holds `L_jk d_k` for the row being factorised.
+pub(super) fn ldl_solve_in_place(matrix: &mut [f64], n: usize, x: &mut [f64], scratch: &mut [f64]) {
     for j in 0..n {
         // w_k = L_jk d_k; d_j = a_jj − Σ_k L_jk w_k.
         let mut diagonal = matrix[j * n + j];
         for k in 0..j {
             let weighted = matrix[j * n + k] * matrix[k * n + k];
             scratch[k] = weighted;
-            diagonal = sub_product::<FUSED>(diagonal, matrix[j * n + k], weighted);
+            diagonal -= matrix[j * n + k] * weighted;
         }
         matrix[j * n + j] = diagonal;
-        let inverse = 1.0 / diagonal;
         // L_ij = (a_ij − Σ_k L_ik w_k) / d_j for the rows below.
         for i in j + 1..n {
-            let mut value = matrix[i * n + j];
-            for k in 0..j {
-                value = sub_product::<FUSED>(value, matrix[i * n + k], scratch[k]);
-            }
-            matrix[i * n + j] = value * inverse;
+            let row = &matrix[i * n..i * n + j];
+            let sum: f64 = row.iter().zip(&scratch[..j]).map(|(l, w)| l * w).sum();
+            matrix[i * n + j] = (matrix[i * n + j] - sum) / diagonal;
         }
     }
     // L y = b, then D z = y, then Lᵀ x = z.
     for i in 0..n {
-        for k in 0..i {
-            x[i] = sub_product::<FUSED>(x[i], matrix[i * n + k], x[k]);
-        }
+        let row = &matrix[i * n..i * n + i];
+        let sum: f64 = row.iter().zip(&x[..i]).map(|(l, v)| l * v).sum();
+        x[i] -= sum;
     }
     for i in 0..n {
         x[i] /= matrix[i * n + i];
@@ -79,7 +55,7 @@ pub(super) fn ldl_solve_in_place<const FUSED: bool>(
     for i in (0..n).rev() {
         let value = x[i];
         for k in 0..i {
-            x[k] = sub_product::<FUSED>(x[k], matrix[i * n + k], value);
+            x[k] -= matrix[i * n + k] * value;
         }
     }
 }
@@ -87,31 +63,28 @@ pub(super) fn ldl_solve_in_place<const FUSED: bool>(
 /// [`ldl_solve_in_place`] on a fixed-size matrix (lower triangle used), for a contact set of
 /// exactly `N` points; the compiler unrolls it.
 #[cfg(test)]
-pub(super) fn ldl_solve_fixed<const N: usize, const FUSED: bool>(
-    matrix: &mut [[f64; N]; N],
-    x: &mut [f64; N],
-) {
-    ldl_factor_fixed::<N, FUSED>(matrix);
-    ldl_substitute_fixed::<N, FUSED>(matrix, x);
+pub(super) fn ldl_solve_fixed<const N: usize>(matrix: &mut [[f64; N]; N], x: &mut [f64; N]) {
+    ldl_factor_fixed(matrix);
+    ldl_substitute_fixed(matrix, x);
 }
 
 /// The LDLᵀ factorisation of [`ldl_solve_fixed`], written over `matrix`: `L` below the diagonal,
 /// `D` on it.
 #[inline(always)]
-pub(super) fn ldl_factor_fixed<const N: usize, const FUSED: bool>(matrix: &mut [[f64; N]; N]) {
+pub(super) fn ldl_factor_fixed<const N: usize>(matrix: &mut [[f64; N]; N]) {
     let mut weighted = [0.0; N];
     for j in 0..N {
         let mut diagonal = matrix[j][j];
         for k in 0..j {
             weighted[k] = matrix[j][k] * matrix[k][k];
-            diagonal = sub_product::<FUSED>(diagonal, matrix[j][k], weighted[k]);
+            diagonal -= matrix[j][k] * weighted[k];
         }
         matrix[j][j] = diagonal;
         let inverse = 1.0 / diagonal;
         for i in j + 1..N {
             let mut value = matrix[i][j];
             for k in 0..j {
-                value = sub_product::<FUSED>(value, matrix[i][k], weighted[k]);
+                value -= matrix[i][k] * weighted[k];
             }
             matrix[i][j] = value * inverse;
         }
@@ -120,13 +93,10 @@ pub(super) fn ldl_factor_fixed<const N: usize, const FUSED: bool>(matrix: &mut [
 
 /// Solves with the factors of [`ldl_factor_fixed`]: `L y = b`, `D z = y`, `Lᵀ x = z`, in place.
 #[inline(always)]
-pub(super) fn ldl_substitute_fixed<const N: usize, const FUSED: bool>(
-    factors: &[[f64; N]; N],
-    x: &mut [f64; N],
-) {
+pub(super) fn ldl_substitute_fixed<const N: usize>(factors: &[[f64; N]; N], x: &mut [f64; N]) {
     for i in 0..N {
         for k in 0..i {
-            x[i] = sub_product::<FUSED>(x[i], factors[i][k], x[k]);
+            x[i] -= factors[i][k] * x[k];
         }
     }
     for i in 0..N {
@@ -134,7 +104,7 @@ pub(super) fn ldl_substitute_fixed<const N: usize, const FUSED: bool>(
     }
     for i in (0..N).rev() {
         for k in 0..i {
-            x[k] = sub_product::<FUSED>(x[k], factors[i][k], x[i]);
+            x[k] -= factors[i][k] * x[i];
         }
     }
 }
@@ -545,9 +515,8 @@ pub fn linearised_fundamental(
 mod tests {
     use super::*;
 
-    /// The general and the fixed-size LDLᵀ, `FUSED` or not, on one system; returns both
-    /// solutions.
-    fn both_ldl_solutions<const FUSED: bool>() -> (Vec<f64>, [f64; 8]) {
+    #[test]
+    fn the_fixed_size_ldl_agrees_with_the_general_one() {
         const SMALL: usize = 8;
         let n = 5;
         let mut general = vec![0.0; n * n];
@@ -570,25 +539,12 @@ mod tests {
         let mut x = rhs.to_vec();
         let mut y = [0.0; SMALL];
         y[..n].copy_from_slice(&rhs);
-        ldl_solve_in_place::<FUSED>(&mut general, n, &mut x, &mut [0.0; 5]);
-        ldl_solve_fixed::<SMALL, FUSED>(&mut small, &mut y);
-        (x, y)
-    }
-
-    #[test]
-    fn the_fixed_size_ldl_agrees_with_the_general_one() {
-        // The same arithmetic in the same order: equal to the last bit, fused or not; the
-        // padding (identity rows) stays zero.
-        let (x, y) = both_ldl_solutions::<false>();
-        assert_eq!(x[..], y[..5]);
-        assert!(y[5..].iter().all(|&v| v == 0.0));
-        let (x_fused, y_fused) = both_ldl_solutions::<true>();
-        assert_eq!(x_fused[..], y_fused[..5]);
-        assert!(y_fused[5..].iter().all(|&v| v == 0.0));
-        // Fusing moves the solution by round-off only.
-        for (fused, unfused) in x_fused.iter().zip(&x) {
-            assert!((fused - unfused).abs() < 1e-14, "{fused} against {unfused}");
+        ldl_solve_in_place(&mut general, n, &mut x, &mut [0.0; 5]);
+        ldl_solve_fixed(&mut small, &mut y);
+        for i in 0..n {
+            assert!((x[i] - y[i]).abs() < 1e-14);
         }
+        assert!(y[n..].iter().all(|&v| v == 0.0));
     }
 
     #[test]
@@ -597,13 +553,7 @@ mod tests {
         let mut matrix = [4.0, 0.0, 0.0, 2.0, 5.0, 0.0, 0.0, 1.0, 3.0];
         let mut x = [2.0, 7.0, 7.0];
         let mut scratch = [0.0; 3];
-        ldl_solve_in_place::<false>(&mut matrix, 3, &mut x, &mut scratch);
-        for (value, expected) in x.iter().zip([0.0, 1.0, 2.0]) {
-            assert!((value - expected).abs() < 1e-14, "{value}");
-        }
-        let mut matrix = [4.0, 0.0, 0.0, 2.0, 5.0, 0.0, 0.0, 1.0, 3.0];
-        let mut x = [2.0, 7.0, 7.0];
-        ldl_solve_in_place::<true>(&mut matrix, 3, &mut x, &mut scratch);
+        ldl_solve_in_place(&mut matrix, 3, &mut x, &mut scratch);
         for (value, expected) in x.iter().zip([0.0, 1.0, 2.0]) {
             assert!((value - expected).abs() < 1e-14, "{value}");
         }

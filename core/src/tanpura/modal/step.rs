@@ -35,17 +35,14 @@
 //!
 //! Hand-written rather than on a linear-algebra crate: the systems are 1–12 points, solved once
 //! or twice per sample on the audio thread; the fixed-size LDLᵀ of `solve.rs` is unrolled by the
-//! compiler, and nothing here allocates. On a vector unit (every unit the step is dispatched to
-//! but the scalar fallback) the solve's multiply-adds are fused (`solve.rs`'s `sub_product`):
-//! the residual, the update and the factorisation are chains of them, one instruction each
-//! instead of two (`docs/performance.md`, "Stop 38").
+//! compiler, and nothing here allocates.
 
 use super::block::{
     contact_case, exact_crossing_step, lanes_of, Block, BlockState, CrossingPoint, BLOCK,
     WIDE_BLOCK,
 };
 use super::points::ContactPoints;
-use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed, sub_product};
+use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
 use crate::newton::NewtonSettings;
 use crate::tanpura::contact::HuntCrossley;
 use pulp::Simd;
@@ -183,11 +180,11 @@ fn scaled(target: &mut [f64], row: &[f64], scale: f64) {
     }
 }
 
-/// `target[i] += row[i] · scale`, fused as [`sub_product`] is when `FUSED`.
+/// `target[i] += row[i] · scale`.
 #[inline(always)]
-fn add_scaled<const FUSED: bool>(target: &mut [f64], row: &[f64], scale: f64) {
+fn add_scaled(target: &mut [f64], row: &[f64], scale: f64) {
     for (t, &g) in target.iter_mut().zip(row) {
-        *t = sub_product::<FUSED>(*t, -g, scale);
+        *t += g * scale;
     }
 }
 
@@ -457,12 +454,7 @@ impl ContactStep {
         band_m: f64,
         release_m: f64,
     ) -> ContactOutcome {
-        // The contact arithmetic fuses its multiply-adds on every vector unit (`sub_product`).
-        let (iterations, converged) = if S::IS_SCALAR {
-            self.solve::<false>(points, settings, band_m)
-        } else {
-            self.solve::<true>(points, settings, band_m)
-        };
+        let (iterations, converged) = self.solve(points, settings, band_m);
         let damping_loss_j = if track_energy {
             self.damping_loss_j()
         } else {
@@ -483,7 +475,7 @@ impl ContactStep {
     /// and the solve is redone; whether a far point then lies within `band_m` of contact is
     /// noted for [`ContactStep::update_tracking`]. Returns (Newton updates, converged).
     #[inline(always)]
-    pub fn solve<const FUSED: bool>(
+    pub fn solve(
         &mut self,
         points: &ContactPoints,
         settings: &NewtonSettings,
@@ -497,12 +489,12 @@ impl ContactStep {
         let mut iterations = 0;
         let mut converged = true;
         loop {
-            let (updates, done) = self.solve_tracked::<FUSED>(settings);
+            let (updates, done) = self.solve_tracked(settings);
             iterations += updates;
             if let Some(done) = done {
                 converged = done;
             }
-            if !self.join_touching::<FUSED>(points, band_m) {
+            if !self.join_touching(points, band_m) {
                 break;
             }
         }
@@ -519,10 +511,7 @@ impl ContactStep {
     /// converged. Up to [`BLOCK`] points (nearly every step) the iteration runs in [`BLOCK`]
     /// fixed lanes (`block.rs`), up to [`WIDE_BLOCK`] in as many; the general path takes more.
     #[inline(always)]
-    fn solve_tracked<const FUSED: bool>(
-        &mut self,
-        settings: &NewtonSettings,
-    ) -> (u32, Option<bool>) {
+    fn solve_tracked(&mut self, settings: &NewtonSettings) -> (u32, Option<bool>) {
         let (tolerance, cap) = (settings.tolerance_m, settings.max_iterations);
         let lanes_allowed = self.fixed_lanes_allowed();
         if self.count <= BLOCK && lanes_allowed {
@@ -530,7 +519,7 @@ impl ContactStep {
             if state.free_of_contact() {
                 return self.settle_free::<BLOCK>();
             }
-            let outcome = state.newton::<FUSED>(&self.block_lanes, tolerance, cap);
+            let outcome = state.newton(&self.block_lanes, tolerance, cap);
             return self.take_block_solution(&state, outcome);
         }
         if self.count <= WIDE_BLOCK && lanes_allowed {
@@ -538,13 +527,13 @@ impl ContactStep {
             if state.free_of_contact() {
                 return self.settle_free::<WIDE_BLOCK>();
             }
-            let outcome = state.newton::<FUSED>(&self.wide_block_lanes, tolerance, cap);
+            let outcome = state.newton(&self.wide_block_lanes, tolerance, cap);
             return self.take_block_solution(&state, outcome);
         }
         if self.settle_if_free() {
             return (0, None);
         }
-        let (updates, done) = self.newton::<FUSED>(settings);
+        let (updates, done) = self.newton(settings);
         self.evaluate();
         (updates, Some(done))
     }
@@ -626,7 +615,7 @@ impl ContactStep {
     /// `Ψ_i s_free + Σ_j G_ij ΔF_j` would bring it into contact joins (returns true: the solve
     /// must be redone).
     #[inline(always)]
-    fn join_touching<const FUSED: bool>(&mut self, points: &ContactPoints, band_m: f64) -> bool {
+    fn join_touching(&mut self, points: &ContactPoints, band_m: f64) -> bool {
         let count = points.len();
         let stride = self.capacity;
         // Σ_j G_ij ΔF_j for every point, a row of G (= its column) per loaded point.
@@ -644,7 +633,7 @@ impl ContactStep {
                 );
                 for &local in rest {
                     let row = self.tracked[local] * stride;
-                    add_scaled::<FUSED>(
+                    add_scaled(
                         coupled,
                         &points.coupling[row..row + count],
                         self.changes[local],
@@ -782,13 +771,13 @@ impl ContactStep {
 
     /// Newton's iteration from the current steps: at most `settings.max_iterations` updates.
     #[inline(always)]
-    fn newton<const FUSED: bool>(&mut self, settings: &NewtonSettings) -> (u32, bool) {
+    fn newton(&mut self, settings: &NewtonSettings) -> (u32, bool) {
         let cap = settings.max_iterations.max(1);
         for iteration in 1..=cap {
             self.evaluate();
             let (crossing, crossing_slot) = self.crossing_points();
             let linear = crossing == 0;
-            let (largest, exact) = self.update::<FUSED>((crossing == 1).then_some(crossing_slot));
+            let (largest, exact) = self.update((crossing == 1).then_some(crossing_slot));
             if !largest.is_finite() {
                 return (iteration, false);
             }
@@ -841,7 +830,7 @@ impl ContactStep {
     /// point that enters or leaves contact during its step), the step is first solved exactly
     /// for the cases of the evaluation point ([`ContactStep::finish_exactly`]).
     #[inline(always)]
-    fn update<const FUSED: bool>(&mut self, crossing: Option<usize>) -> (f64, bool) {
+    fn update(&mut self, crossing: Option<usize>) -> (f64, bool) {
         let count = self.count;
         let stride = self.slot_stride;
         // R = Δu − Δu_free − G ΔF, with ΔF ≠ 0 only on the loaded points (G is symmetric, so
@@ -858,7 +847,7 @@ impl ContactStep {
             let change = self.changes[u];
             let row = &self.block[u * stride..u * stride + count];
             for (r, g) in residual.iter_mut().zip(row) {
-                *r = sub_product::<FUSED>(*r, *g, change);
+                *r -= g * change;
             }
         }
         // A: the points with c > 0, and D = diag(√c) on them.
@@ -874,15 +863,15 @@ impl ContactStep {
         let crossing = crossing.filter(|_| size <= 8);
         match size {
             0 => {}
-            1 => self.solve_active_fixed::<1, FUSED>(crossing),
-            2 => self.solve_active_fixed::<2, FUSED>(crossing),
-            3 => self.solve_active_fixed::<3, FUSED>(crossing),
-            4 => self.solve_active_fixed::<4, FUSED>(crossing),
-            5 => self.solve_active_fixed::<5, FUSED>(crossing),
-            6 => self.solve_active_fixed::<6, FUSED>(crossing),
-            7 => self.solve_active_fixed::<7, FUSED>(crossing),
-            8 => self.solve_active_fixed::<8, FUSED>(crossing),
-            _ => self.solve_active_any::<FUSED>(size),
+            1 => self.solve_active_fixed::<1>(crossing),
+            2 => self.solve_active_fixed::<2>(crossing),
+            3 => self.solve_active_fixed::<3>(crossing),
+            4 => self.solve_active_fixed::<4>(crossing),
+            5 => self.solve_active_fixed::<5>(crossing),
+            6 => self.solve_active_fixed::<6>(crossing),
+            7 => self.solve_active_fixed::<7>(crossing),
+            8 => self.solve_active_fixed::<8>(crossing),
+            _ => self.solve_active_any(size),
         }
         // δ = −R − G_{:,A} D y, a row of the block per active point.
         let deltas = &mut self.scratch[..count];
@@ -894,11 +883,11 @@ impl ContactStep {
             let row = &self.block[row_start..row_start + count];
             let weight = self.solution[a];
             for (d, g) in deltas.iter_mut().zip(row) {
-                *d = sub_product::<FUSED>(*d, *g, weight);
+                *d -= g * weight;
             }
         }
         if let Some(crossing) = crossing {
-            if let Some(largest) = self.finish_exactly::<FUSED>(crossing, size) {
+            if let Some(largest) = self.finish_exactly(crossing, size) {
                 return (largest, true);
             }
         }
@@ -933,7 +922,7 @@ impl ContactStep {
     /// Newton's own iterates converge to the same root quadratically but from far away, one
     /// update for every digit pair (3–4 more updates per crossing with stiff contact).
     #[inline(always)]
-    fn finish_exactly<const FUSED: bool>(&mut self, crossing: usize, size: usize) -> Option<f64> {
+    fn finish_exactly(&mut self, crossing: usize, size: usize) -> Option<f64> {
         let count = self.count;
         let stride = self.slot_stride;
         // w = J⁻¹ G e_c = G e_c − G_{:,A} D y', (I + D G_AA D) y' = D G_{A,c}.
@@ -944,7 +933,7 @@ impl ContactStep {
             let row = &self.block[row_start..row_start + count];
             let weight = self.second_solution[a];
             for (w, g) in direction.iter_mut().zip(row) {
-                *w = sub_product::<FUSED>(*w, *g, weight);
+                *w -= g * weight;
             }
         }
         let (step, departure) = exact_crossing_step(CrossingPoint {
@@ -983,7 +972,7 @@ impl ContactStep {
     /// points (the loops unroll and the arrays stay in registers); with `crossing`, also
     /// `(I + D G_AA D) y' = D G_{A,c}` with the same factors, `D y'` into `second_solution[..N]`.
     #[inline(always)]
-    fn solve_active_fixed<const N: usize, const FUSED: bool>(&mut self, crossing: Option<usize>) {
+    fn solve_active_fixed<const N: usize>(&mut self, crossing: Option<usize>) {
         let stride = self.slot_stride;
         let mut matrix = [[0.0; N]; N];
         let mut y = [0.0; N];
@@ -995,8 +984,8 @@ impl ContactStep {
             matrix[a][a] += 1.0;
             y[a] = -self.roots[a] * self.residual[self.active[a]];
         }
-        ldl_factor_fixed::<N, FUSED>(&mut matrix);
-        ldl_substitute_fixed::<N, FUSED>(&matrix, &mut y);
+        ldl_factor_fixed(&mut matrix);
+        ldl_substitute_fixed(&matrix, &mut y);
         for a in 0..N {
             self.solution[a] = y[a] * self.roots[a];
         }
@@ -1006,7 +995,7 @@ impl ContactStep {
             for a in 0..N {
                 second[a] = self.roots[a] * column[self.active[a]];
             }
-            ldl_substitute_fixed::<N, FUSED>(&matrix, &mut second);
+            ldl_substitute_fixed(&matrix, &mut second);
             for a in 0..N {
                 self.second_solution[a] = second[a] * self.roots[a];
             }
@@ -1015,7 +1004,7 @@ impl ContactStep {
 
     /// [`ContactStep::solve_active_fixed`] for any size, in the heap buffers. The matrix is SPD
     /// with eigenvalues ≥ 1, so LDLᵀ without pivoting is exact and stable.
-    fn solve_active_any<const FUSED: bool>(&mut self, size: usize) {
+    fn solve_active_any(&mut self, size: usize) {
         let stride = self.slot_stride;
         let matrix = &mut self.matrix[..size * size];
         for a in 0..size {
@@ -1027,7 +1016,7 @@ impl ContactStep {
             self.solution[a] = -self.roots[a] * self.residual[self.active[a]];
         }
         let solution = &mut self.solution[..size];
-        ldl_solve_in_place::<FUSED>(matrix, size, solution, &mut self.scratch[..size]);
+        ldl_solve_in_place(matrix, size, solution, &mut self.scratch[..size]);
         for (y, root) in solution.iter_mut().zip(&self.roots[..size]) {
             *y *= root;
         }
