@@ -1093,4 +1093,48 @@ mod tests {
         }
         assert!(all_widths.iter().all(|&steps| steps > 0), "{all_widths:?}");
     }
+
+    /// The scalar fallback, the step a machine without AVX2 and FMA runs (the shipped binary
+    /// dispatches at run time), plays the string the machine's vector unit plays, to round-off:
+    /// f64 modes, so that f32's rounding does not hide a difference in the contact solve (the
+    /// mode kernels' multiply-adds are fused on the vector units only). 2e-13 N apart over 0.1 s
+    /// at a peak of 2.1 N on the AVX-512 machine of `docs/performance.md`.
+    #[test]
+    fn the_scalar_fallback_plays_the_string_the_vector_unit_plays() {
+        let run = |scalar: bool| {
+            let mut string = ModalString::<f64>::new(ModalStringConfig::REFERENCE);
+            string.pluck(&Pluck {
+                amplitude_m: 3e-3,
+                ..Pluck::default()
+            });
+            let mut output = Vec::new();
+            for _ in 0..4_410 {
+                if scalar {
+                    pulp::Scalar.vectorize(WholeStep {
+                        string: &mut string,
+                    });
+                } else {
+                    string.step();
+                }
+                output.push(string.bridge_force_n());
+            }
+            (output, *string.newton_stats())
+        };
+        let (vector, vector_stats) = run(false);
+        let (scalar, scalar_stats) = run(true);
+        let peak = vector
+            .iter()
+            .fold(0.0f64, |peak, force| peak.max(force.abs()));
+        let largest = vector
+            .iter()
+            .zip(&scalar)
+            .fold(0.0f64, |largest, (a, b)| largest.max((a - b).abs()));
+        assert!(peak > 0.0 && scalar.iter().all(|force| force.is_finite()));
+        assert!(largest <= 1e-10 * peak, "{largest} N apart, peak {peak} N");
+        assert!(
+            scalar_stats.iterations > scalar_stats.steps,
+            "{scalar_stats:?}"
+        );
+        eprintln!("vector {vector_stats:?}, scalar {scalar_stats:?}: {largest:e} N apart");
+    }
 }
