@@ -1,9 +1,11 @@
 //! What retuning a ringing string costs per tier (`TanpuraVoice::set_settings`): 200 changes of
 //! the thread position (a new rest state and the tuning passes), then 200 of γ only, each
 //! followed by one output sample, against the cost of one sample and a 64-sample block's
-//! deadline. `cargo run --release -p javari-core --example retune_cost [TIER ...]`
-//! (docs/performance.md); with tier names (draft, live, studio) only those tiers.
+//! deadline. `cargo run --release -p javari-core --example retune_cost [TIER ...] [key=NN]`
+//! (docs/performance.md); with tier names (draft, live, studio) only those tiers, with `key=NN`
+//! the string at that MIDI key instead of D3.
 
+use javari_core::engine::pitch::note_to_hz;
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
@@ -27,14 +29,19 @@ fn main() {
         "deadline of a 64-sample block at 44.1 kHz: {:.0} µs",
         64.0 / RATE * 1e6
     );
-    let chosen: Vec<String> = std::env::args().skip(1).collect();
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    // `key=NN`: the string at that MIDI key instead of D3.
+    let fundamental_hz = args
+        .iter()
+        .find_map(|arg| arg.strip_prefix("key="))
+        .map_or(146.8, |key| note_to_hz(key.parse().expect("key=NN")));
+    let chosen: Vec<&String> = args.iter().filter(|arg| !arg.starts_with("key=")).collect();
     let tiers = [Quality::Draft, Quality::Live, Quality::Studio];
-    for quality in tiers
-        .into_iter()
-        .filter(|quality| chosen.is_empty() || chosen.iter().any(|name| name == quality.name()))
-    {
+    for quality in tiers.into_iter().filter(|quality| {
+        chosen.is_empty() || chosen.iter().any(|name| name.as_str() == quality.name())
+    }) {
         let settings = VoiceSettings {
-            fundamental_hz: 146.8,
+            fundamental_hz,
             quality,
             ..VoiceSettings::default()
         };

@@ -58,6 +58,13 @@ const MAX_FINGER_WIDTH_M: f64 = 0.040;
 /// The residual modes ring at this fraction of the sample rate: above the kept modes (at most
 /// 0.45 of it) and below Nyquist.
 const RESIDUAL_MODE_RATE_FRACTION: f64 = 0.475;
+/// The thread's lattices tried, in order, as offsets of its points from the thread's top in
+/// fractions of their spacing (the first symmetric about the top, the second straddling it);
+/// [`ModalString::place_thread_lattice`].
+const THREAD_LATTICE_OFFSETS: [f64; 4] = [0.0, 0.5, 0.25, 0.75];
+/// The first lattice whose thread points all lie at least this far from the rest state's
+/// contact edges ([`ModalString::thread_edge_margin`]) is kept.
+const THREAD_EDGE_MARGIN: f64 = 0.25;
 /// Far points are put to sleep this often (the check costs a pass over the modes and points).
 const SLEEP_CHECK_STEPS: usize = 256;
 /// Inverse iterations for the linearised fundamental (the error falls by (f₁/f₂)² ≈ 1/4 each).
@@ -222,6 +229,8 @@ pub struct ModalString<T: Real> {
     points: ContactPoints,
     /// ‖Ψ_i‖ per point (every mode the step advances), m/√J: what bounds a point's reach.
     shape_norms: Vec<f64>,
+    /// The thread's points' offset from its top, m ([`ModalString::place_thread_lattice`]).
+    thread_offset_m: f64,
     /// Steps since far points were last put to sleep.
     steps_since_sleep_check: usize,
     contact: ContactStep,
@@ -262,6 +271,7 @@ impl<T: Real> ModalString<T> {
             shapes: CacheAligned::new(points * MODE_CAPACITY, T::default()),
             points: ContactPoints::with_capacity(points),
             shape_norms: vec![0.0; points],
+            thread_offset_m: 0.0,
             steps_since_sleep_check: 0,
             contact: ContactStep::new(points),
             solver: StaticSolver::new(points + finger),
@@ -336,6 +346,93 @@ impl<T: Real> ModalString<T> {
             &config.string,
             config.time_step_s,
         );
+        self.lanes = padded_lanes(self.modes.count());
+        for k in 0..MODE_CAPACITY {
+            self.a[k] = T::from_f64(self.modes.a[k]);
+            self.b[k] = T::from_f64(self.modes.b[k]);
+            self.nut_weights[k] = T::from_f64(self.modes.nut_weight[k]);
+        }
+        self.place_thread_lattice();
+    }
+
+    /// Places the points, the thread's on the first of [`THREAD_LATTICE_OFFSETS`] whose points
+    /// all keep [`THREAD_EDGE_MARGIN`] from the rest state's contact edges, or on the one with
+    /// the largest margin; leaves the rest state solved on the lattice tried last.
+    ///
+    /// A thread point that lies at the edge of the string's contact at rest (barely touching,
+    /// or barely clear) enters and leaves contact with the smallest vibration, so the contact
+    /// solve takes a second Newton update in many steps; which points lie there depends on where
+    /// the lattice falls against the contact region, which moves with the string's tension. At
+    /// the live tier's 0.5 mm points, over 1 s of the one-string scene: key 59 takes 1.654
+    /// updates per step with a point on the thread's top and 1.080 with the lattice straddling
+    /// it, key 51 1.046 and 1.797 (`docs/performance.md`, "Stop 38"). The lattice is a function
+    /// of the configuration alone (the order of the offsets tried is fixed), and the contact
+    /// grid's spacing is converged within the playing range's spread (stop 30's 0.25 mm control),
+    /// so the choice moves a render by that spread at most. Allocation-free; on a retune of a
+    /// ringing string it costs one more static solve per lattice tried.
+    fn place_thread_lattice(&mut self) {
+        let spacing_m = self.config.thread_point_spacing_m;
+        let mut best = (f64::NEG_INFINITY, 0.0);
+        for (tried, fraction) in THREAD_LATTICE_OFFSETS.into_iter().enumerate() {
+            let offset_m = fraction * spacing_m;
+            self.place_points(offset_m);
+            if self.config.thread.is_none() {
+                return;
+            }
+            self.update_rest_state();
+            let margin = self.thread_edge_margin();
+            if margin >= THREAD_EDGE_MARGIN {
+                return;
+            }
+            if margin > best.0 {
+                best = (margin, offset_m);
+            }
+            if tried + 1 == THREAD_LATTICE_OFFSETS.len() && best.1 != offset_m {
+                self.place_points(best.1);
+                self.update_rest_state();
+            }
+        }
+    }
+
+    /// How far the thread's points lie from the rest state's contact edges, the least over its
+    /// points: a point in contact by its rest force over the largest of the thread's, a point
+    /// clear of it by its gap over the cap's drop over one spacing (`Δx² / 2R_c`, the gap of
+    /// the point next to one that touches the cap's top). 0 for a point at an edge; 1 or more
+    /// for none near one. Infinite without a thread.
+    fn thread_edge_margin(&self) -> f64 {
+        let Some(thread) = self.config.thread else {
+            return f64::INFINITY;
+        };
+        let points = &self.points;
+        let thread_points = points.bridge_count()..points.len();
+        let largest_force_n = points.rest_forces_n[thread_points.clone()]
+            .iter()
+            .fold(0.0f64, |largest, &force| largest.max(force));
+        let spacing_m = self.config.thread_point_spacing_m;
+        let gap_scale_m = spacing_m * spacing_m / (2.0 * thread.curvature_radius_m);
+        thread_points
+            .map(|i| {
+                let force_n = points.rest_forces_n[i];
+                if force_n > 0.0 {
+                    force_n / largest_force_n
+                } else {
+                    // A rest gap is negative clear of contact.
+                    (-points.rest_gaps_m[i]).max(0.0) / gap_scale_m
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The thread's points' offset from its top, m (0: a point on the top).
+    pub fn thread_lattice_offset_m(&self) -> f64 {
+        self.thread_offset_m
+    }
+
+    /// Places the points (the thread's lattice `thread_offset_m` from its top) and couples
+    /// them to the modes.
+    fn place_points(&mut self, thread_offset_m: f64) {
+        let config = self.config;
+        self.thread_offset_m = thread_offset_m;
         self.points.place(
             &config.bridge,
             config.bridge_start_m(),
@@ -343,18 +440,13 @@ impl<T: Real> ModalString<T> {
             config.bridge_point_spacing_m,
             config.thread.as_ref(),
             config.thread_point_spacing_m,
+            thread_offset_m,
             config.time_step_s,
             config.string.left_support_m,
             config.string.length_m,
         );
         self.points
             .couple(&self.modes, config.static_flexibility, &self.kernels);
-        self.lanes = padded_lanes(self.modes.count());
-        for k in 0..MODE_CAPACITY {
-            self.a[k] = T::from_f64(self.modes.a[k]);
-            self.b[k] = T::from_f64(self.modes.b[k]);
-            self.nut_weights[k] = T::from_f64(self.modes.nut_weight[k]);
-        }
         for (target, source) in self.shapes.iter_mut().zip(&self.points.shapes) {
             *target = T::from_f64(*source);
         }

@@ -122,9 +122,10 @@ impl ContactPoints {
     }
 
     /// Places the points on bridge and thread (a point per `spacing` over the part of each
-    /// barrier with a positive stiffness) and sets their laws for the step `time_step_s`.
-    /// Points beyond the capacity are dropped. `left_support_m` and `length_m` give the line
-    /// y_s. Allocation-free.
+    /// barrier with a positive stiffness; the thread's lattice `thread_offset_m` from its top,
+    /// which with 0 is symmetric about the thread with a point on the top) and sets their laws
+    /// for the step `time_step_s`. Points beyond the capacity are dropped. `left_support_m` and
+    /// `length_m` give the line y_s. Allocation-free.
     #[allow(clippy::too_many_arguments)]
     pub fn place(
         &mut self,
@@ -134,6 +135,7 @@ impl ContactPoints {
         bridge_spacing_m: f64,
         thread: Option<&ThreadSettings>,
         thread_spacing_m: f64,
+        thread_offset_m: f64,
         time_step_s: f64,
         left_support_m: f64,
         length_m: f64,
@@ -155,10 +157,11 @@ impl ContactPoints {
         }
         self.bridge_count = self.count;
         if let Some(thread) = thread.filter(|thread| thread.stiffness_n_m2 > 0.0) {
-            // Symmetric about the thread, with a point on its top.
             let side = (thread.half_width_m() / thread_spacing_m).floor() as usize;
             for index in 0..2 * side + 1 {
-                let x = thread.position_m + (index as f64 - side as f64) * thread_spacing_m;
+                let x = thread.position_m
+                    + thread_offset_m
+                    + (index as f64 - side as f64) * thread_spacing_m;
                 self.push(
                     x,
                     thread.height_over(bridge, x),
@@ -367,6 +370,7 @@ mod tests {
             1e-3,
             Some(&thread),
             1e-3,
+            0.0,
             1.0 / 44_100.0,
             -2e-3,
             0.668,
