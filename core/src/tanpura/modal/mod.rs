@@ -366,10 +366,11 @@ impl<T: Real> ModalString<T> {
     /// the live tier's 0.5 mm points, over 1 s of the one-string scene: key 59 takes 1.654
     /// updates per step with a point on the thread's top and 1.080 with the lattice straddling
     /// it, key 51 1.046 and 1.797 (`docs/performance.md`, "Stop 38"). The lattice is a function
-    /// of the configuration alone (the order of the offsets tried is fixed), and the contact
-    /// grid's spacing is converged within the playing range's spread (stop 30's 0.25 mm control),
-    /// so the choice moves a render by that spread at most. Allocation-free; on a retune of a
-    /// ringing string it costs one more static solve per lattice tried.
+    /// of the configuration alone (the order of the offsets tried is fixed). It moves the sound
+    /// where it moves: over the bench's playing range, against the string refined fourfold, the
+    /// plucks at keys 36–45 came 0.56 dB nearer in band levels and those at keys 59–64 went
+    /// 0.71 dB farther (README, *This run (stop 38)*). Allocation-free; on a retune of a ringing
+    /// string it costs one more static solve per lattice tried.
     fn place_thread_lattice(&mut self) {
         let spacing_m = self.config.thread_point_spacing_m;
         let mut best = (f64::NEG_INFINITY, 0.0);
