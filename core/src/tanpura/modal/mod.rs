@@ -320,8 +320,8 @@ impl<T: Real> ModalString<T> {
             self.whole_step[k] = T::from_f64(self.velocity[k].to_f64() * scale);
         }
         self.config = config;
+        // Leaves the rest state solved for the new configuration (`place_thread_lattice`).
         self.apply_config();
-        self.update_rest_state();
         let count = self.modes.count();
         for k in 0..MODE_CAPACITY {
             let root = if k < count {
@@ -356,8 +356,9 @@ impl<T: Real> ModalString<T> {
     }
 
     /// Places the points, the thread's on the first of [`THREAD_LATTICE_OFFSETS`] whose points
-    /// all keep [`THREAD_EDGE_MARGIN`] from the rest state's contact edges, or on the one with
-    /// the largest margin; leaves the rest state solved on the lattice tried last.
+    /// all keep [`THREAD_EDGE_MARGIN`] from the rest state's contact edges (the first at once
+    /// without a thread: its margin is infinite), or on the one with the largest margin; leaves
+    /// the rest state solved on the lattice it keeps, one static solve per lattice tried.
     ///
     /// A thread point that lies at the edge of the string's contact at rest (barely touching,
     /// or barely clear) enters and leaves contact with the smallest vibration, so the contact
@@ -369,17 +370,14 @@ impl<T: Real> ModalString<T> {
     /// of the configuration alone (the order of the offsets tried is fixed). It moves the sound
     /// where it moves: over the bench's playing range, against the string refined fourfold, the
     /// plucks at keys 36–45 came 0.56 dB nearer in band levels and those at keys 59–64 went
-    /// 0.71 dB farther (README, *This run (stop 38)*). Allocation-free; on a retune of a ringing
-    /// string it costs one more static solve per lattice tried.
+    /// 0.71 dB farther (README, *This run (stop 38)*). Allocation-free; a retune solves the rest
+    /// state once per lattice tried (once where the first is kept, as before the rule).
     fn place_thread_lattice(&mut self) {
         let spacing_m = self.config.thread_point_spacing_m;
         let mut best = (f64::NEG_INFINITY, 0.0);
-        for (tried, fraction) in THREAD_LATTICE_OFFSETS.into_iter().enumerate() {
+        for fraction in THREAD_LATTICE_OFFSETS {
             let offset_m = fraction * spacing_m;
             self.place_points(offset_m);
-            if self.config.thread.is_none() {
-                return;
-            }
             self.update_rest_state();
             let margin = self.thread_edge_margin();
             if margin >= THREAD_EDGE_MARGIN {
@@ -388,10 +386,10 @@ impl<T: Real> ModalString<T> {
             if margin > best.0 {
                 best = (margin, offset_m);
             }
-            if tried + 1 == THREAD_LATTICE_OFFSETS.len() && best.1 != offset_m {
-                self.place_points(best.1);
-                self.update_rest_state();
-            }
+        }
+        if best.1 != self.thread_offset_m {
+            self.place_points(best.1);
+            self.update_rest_state();
         }
     }
 
