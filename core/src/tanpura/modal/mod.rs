@@ -58,13 +58,13 @@ const MAX_FINGER_WIDTH_M: f64 = 0.040;
 /// The residual modes ring at this fraction of the sample rate: above the kept modes (at most
 /// 0.45 of it) and below Nyquist.
 const RESIDUAL_MODE_RATE_FRACTION: f64 = 0.475;
-/// The thread's lattices tried, in order, as offsets of its points from the thread's top in
-/// fractions of their spacing (the first symmetric about the top, the second straddling it);
+/// The thread's lattices tried, in order, as spacings of its points in fractions of the
+/// configured spacing, each with a point on the thread's top (the first the configured one);
 /// [`ModalString::place_thread_lattice`].
-const THREAD_LATTICE_OFFSETS: [f64; 4] = [0.0, 0.5, 0.25, 0.75];
+const THREAD_LATTICE_SPACINGS: [f64; 5] = [1.0, 0.9, 1.1, 0.85, 1.15];
 /// The first lattice whose thread points all lie at least this far from the rest state's
 /// contact edges ([`ModalString::thread_edge_margin`]) is kept.
-const THREAD_EDGE_MARGIN: f64 = 0.25;
+const THREAD_EDGE_MARGIN: f64 = 0.35;
 /// Far points are put to sleep this often (the check costs a pass over the modes and points).
 const SLEEP_CHECK_STEPS: usize = 256;
 /// Inverse iterations for the linearised fundamental (the error falls by (f₁/f₂)² ≈ 1/4 each).
@@ -190,7 +190,12 @@ impl ModalStringConfig {
         let half_width = ThreadSettings::SEED
             .half_width_m()
             .max(self.thread.map_or(0.0, |thread| thread.half_width_m()));
-        let thread = 2 * (half_width / self.thread_point_spacing_m).floor() as usize + 1;
+        // Room for the finest lattice tried.
+        let finest = THREAD_LATTICE_SPACINGS
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+        let finest_spacing_m = finest * self.thread_point_spacing_m;
+        let thread = 2 * (half_width / finest_spacing_m).floor() as usize + 1;
         bridge + thread
     }
 }
@@ -229,8 +234,8 @@ pub struct ModalString<T: Real> {
     points: ContactPoints,
     /// ‖Ψ_i‖ per point (every mode the step advances), m/√J: what bounds a point's reach.
     shape_norms: Vec<f64>,
-    /// The thread's points' offset from its top, m ([`ModalString::place_thread_lattice`]).
-    thread_offset_m: f64,
+    /// The thread's points' spacing, m ([`ModalString::place_thread_lattice`]).
+    thread_spacing_m: f64,
     /// Steps since far points were last put to sleep.
     steps_since_sleep_check: usize,
     contact: ContactStep,
@@ -271,7 +276,7 @@ impl<T: Real> ModalString<T> {
             shapes: CacheAligned::new(points * MODE_CAPACITY, T::default()),
             points: ContactPoints::with_capacity(points),
             shape_norms: vec![0.0; points],
-            thread_offset_m: 0.0,
+            thread_spacing_m: config.thread_point_spacing_m,
             steps_since_sleep_check: 0,
             contact: ContactStep::new(points),
             solver: StaticSolver::new(points + finger),
@@ -355,9 +360,9 @@ impl<T: Real> ModalString<T> {
         self.place_thread_lattice();
     }
 
-    /// Places the points, the thread's on the first of [`THREAD_LATTICE_OFFSETS`] whose points
+    /// Places the points, the thread's at the first of [`THREAD_LATTICE_SPACINGS`] whose points
     /// all keep [`THREAD_EDGE_MARGIN`] from the rest state's contact edges (the first at once
-    /// without a thread: its margin is infinite), or on the one with the largest margin; leaves
+    /// without a thread: its margin is infinite), or at the one with the largest margin; leaves
     /// the rest state solved on the lattice it keeps, one static solve per lattice tried.
     ///
     /// A thread point that lies at the edge of the string's contact at rest (barely touching,
@@ -366,29 +371,34 @@ impl<T: Real> ModalString<T> {
     /// the lattice falls against the contact region, which moves with the string's tension. At
     /// the live tier's 0.5 mm points, over 1 s of the one-string scene: key 59 takes 1.654
     /// updates per step with a point on the thread's top and 1.080 with the lattice straddling
-    /// it, key 51 1.046 and 1.797 (`docs/performance.md`, "Stop 38"). The lattice is a function
-    /// of the configuration alone (the order of the offsets tried is fixed). It moves the sound
-    /// where it moves: over the bench's playing range, against the string refined fourfold, the
-    /// plucks at keys 36–45 came 0.56 dB nearer in band levels and those at keys 59–64 went
-    /// 0.71 dB farther (README, *This run (stop 38)*). Allocation-free; a retune solves the rest
-    /// state once per lattice tried (once where the first is kept, as before the rule).
+    /// it, key 51 1.046 and 1.797 (`docs/performance.md`, "Stop 38"). Every lattice keeps a point
+    /// on the thread's top, where the string presses hardest, and changes its spacing: over the
+    /// bench's playing range, against the string refined fourfold, that moves keys 59–64 by
+    /// half as much in band levels as stop 38's shifted lattices did (+0.37 dB against +0.71;
+    /// `docs/performance.md`, "Stop 39"). The lattice is a function of the configuration alone
+    /// (the order of the spacings tried is fixed). Allocation-free; a retune solves the rest
+    /// state once per lattice tried (once where the first is kept).
     fn place_thread_lattice(&mut self) {
-        let spacing_m = self.config.thread_point_spacing_m;
-        let mut best = (f64::NEG_INFINITY, 0.0);
-        for fraction in THREAD_LATTICE_OFFSETS {
-            let offset_m = fraction * spacing_m;
-            self.place_points(offset_m);
+        let configured_m = self.config.thread_point_spacing_m;
+        let mut best = (f64::NEG_INFINITY, configured_m);
+        for (tried, fraction) in THREAD_LATTICE_SPACINGS.into_iter().enumerate() {
+            let spacing_m = fraction * configured_m;
+            if tried == 0 {
+                self.place_points(spacing_m);
+            } else {
+                self.place_thread_points(spacing_m);
+            }
             self.update_rest_state();
             let margin = self.thread_edge_margin();
             if margin >= THREAD_EDGE_MARGIN {
                 return;
             }
             if margin > best.0 {
-                best = (margin, offset_m);
+                best = (margin, spacing_m);
             }
         }
-        if best.1 != self.thread_offset_m {
-            self.place_points(best.1);
+        if best.1 != self.thread_spacing_m {
+            self.place_thread_points(best.1);
             self.update_rest_state();
         }
     }
@@ -407,7 +417,7 @@ impl<T: Real> ModalString<T> {
         let largest_force_n = points.rest_forces_n[thread_points.clone()]
             .iter()
             .fold(0.0f64, |largest, &force| largest.max(force));
-        let spacing_m = self.config.thread_point_spacing_m;
+        let spacing_m = self.thread_spacing_m;
         let gap_scale_m = spacing_m * spacing_m / (2.0 * thread.curvature_radius_m);
         thread_points
             .map(|i| {
@@ -422,34 +432,71 @@ impl<T: Real> ModalString<T> {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// The thread's points' offset from its top, m (0: a point on the top).
-    pub fn thread_lattice_offset_m(&self) -> f64 {
-        self.thread_offset_m
+    /// The thread's points' spacing, m ([`ModalString::place_thread_lattice`]).
+    pub fn thread_lattice_spacing_m(&self) -> f64 {
+        self.thread_spacing_m
     }
 
-    /// Places the points (the thread's lattice `thread_offset_m` from its top) and couples
-    /// them to the modes.
-    fn place_points(&mut self, thread_offset_m: f64) {
+    /// Places the points (the thread's `thread_spacing_m` apart) and couples them to the modes.
+    fn place_points(&mut self, thread_spacing_m: f64) {
         let config = self.config;
-        self.thread_offset_m = thread_offset_m;
+        self.thread_spacing_m = thread_spacing_m;
         self.points.place(
             &config.bridge,
             config.bridge_start_m(),
             config.bridge_end_m(),
             config.bridge_point_spacing_m,
             config.thread.as_ref(),
-            config.thread_point_spacing_m,
-            thread_offset_m,
+            thread_spacing_m,
             config.time_step_s,
             config.string.left_support_m,
             config.string.length_m,
         );
-        self.points
-            .couple(&self.modes, config.static_flexibility, &self.kernels);
-        for (target, source) in self.shapes.iter_mut().zip(&self.points.shapes) {
+        self.couple_points_from(0);
+    }
+
+    /// Places the thread's points anew, `thread_spacing_m` apart, after [`Self::place_points`]
+    /// for the same configuration: the bridge's points and their coupling stay.
+    fn place_thread_points(&mut self, thread_spacing_m: f64) {
+        let config = self.config;
+        self.thread_spacing_m = thread_spacing_m;
+        self.points.place_thread(
+            &config.bridge,
+            config.thread.as_ref(),
+            thread_spacing_m,
+            config.time_step_s,
+            config.string.left_support_m,
+            config.string.length_m,
+        );
+        self.couple_points_from(self.points.bridge_count());
+    }
+
+    /// Couples the points `first..` to the modes (those before unchanged since they were).
+    fn couple_points_from(&mut self, first: usize) {
+        self.points.couple_from(
+            first,
+            &self.modes,
+            self.config.static_flexibility,
+            &self.kernels,
+        );
+        // With residual modes every point's row changed (`ContactPoints::couple_from`).
+        let first = if self.modes.count() > self.modes.kept() {
+            0
+        } else {
+            first
+        };
+        let rows = first * MODE_CAPACITY..;
+        for (target, source) in self.shapes[rows.clone()]
+            .iter_mut()
+            .zip(&self.points.shapes[rows])
+        {
             *target = T::from_f64(*source);
         }
-        for (i, norm) in self.shape_norms[..self.points.len()].iter_mut().enumerate() {
+        for (i, norm) in self.shape_norms[..self.points.len()]
+            .iter_mut()
+            .enumerate()
+            .skip(first)
+        {
             *norm = self
                 .points
                 .shape(i)

@@ -122,10 +122,9 @@ impl ContactPoints {
     }
 
     /// Places the points on bridge and thread (a point per `spacing` over the part of each
-    /// barrier with a positive stiffness; the thread's lattice `thread_offset_m` from its top,
-    /// which with 0 is symmetric about the thread with a point on the top) and sets their laws
-    /// for the step `time_step_s`. Points beyond the capacity are dropped. `left_support_m` and
-    /// `length_m` give the line y_s. Allocation-free.
+    /// barrier with a positive stiffness; the thread's symmetric about its top, with a point on
+    /// the top) and sets their laws for the step `time_step_s`. Points beyond the capacity are
+    /// dropped. `left_support_m` and `length_m` give the line y_s. Allocation-free.
     #[allow(clippy::too_many_arguments)]
     pub fn place(
         &mut self,
@@ -135,7 +134,6 @@ impl ContactPoints {
         bridge_spacing_m: f64,
         thread: Option<&ThreadSettings>,
         thread_spacing_m: f64,
-        thread_offset_m: f64,
         time_step_s: f64,
         left_support_m: f64,
         length_m: f64,
@@ -156,12 +154,37 @@ impl ContactPoints {
             }
         }
         self.bridge_count = self.count;
+        for i in 0..self.bridge_count {
+            let line = left_support_m * (1.0 - self.positions_m[i] / length_m);
+            self.free_gaps_m[i] = self.heights_m[i] - line;
+        }
+        self.place_thread(
+            bridge,
+            thread,
+            thread_spacing_m,
+            time_step_s,
+            left_support_m,
+            length_m,
+        );
+    }
+
+    /// Places the thread's points anew, `thread_spacing_m` apart, and keeps the bridge's (the
+    /// points `0..bridge_count()` from the last [`ContactPoints::place`]): the rest of `place`.
+    /// Allocation-free.
+    pub fn place_thread(
+        &mut self,
+        bridge: &BridgeSettings,
+        thread: Option<&ThreadSettings>,
+        thread_spacing_m: f64,
+        time_step_s: f64,
+        left_support_m: f64,
+        length_m: f64,
+    ) {
+        self.count = self.bridge_count;
         if let Some(thread) = thread.filter(|thread| thread.stiffness_n_m2 > 0.0) {
             let side = (thread.half_width_m() / thread_spacing_m).floor() as usize;
             for index in 0..2 * side + 1 {
-                let x = thread.position_m
-                    + thread_offset_m
-                    + (index as f64 - side as f64) * thread_spacing_m;
+                let x = thread.position_m + (index as f64 - side as f64) * thread_spacing_m;
                 self.push(
                     x,
                     thread.height_over(bridge, x),
@@ -172,7 +195,7 @@ impl ContactPoints {
                 );
             }
         }
-        for i in 0..self.count {
+        for i in self.bridge_count..self.count {
             let line = left_support_m * (1.0 - self.positions_m[i] / length_m);
             self.free_gaps_m[i] = self.heights_m[i] - line;
         }
@@ -211,9 +234,30 @@ impl ContactPoints {
     /// is `Ψ_j · (Ψ_i ⊙ b)` and `Ψ_j · Ψ_i` for j ≤ i. It runs on every retune of a ringing
     /// string (each tuning pass), so it is on the audio thread's path.
     pub fn couple(&mut self, modes: &ModeSet, flexible: bool, kernels: &Kernels) {
+        self.couple_from(0, modes, flexible, kernels);
+    }
+
+    /// [`ContactPoints::couple`] for the points `first..` alone, whose positions changed while
+    /// those before kept theirs and their coupling (a thread placed anew by
+    /// [`ContactPoints::place_thread`] after `couple`, the modes unchanged): the rows of Ψ, G
+    /// and R from `first` on, which also holds the columns below `first` by symmetry; the same
+    /// numbers `couple` gives, at a fraction of its cost. The residual modes' shapes depend on
+    /// every point, so with residual modes it couples them all.
+    pub fn couple_from(
+        &mut self,
+        first: usize,
+        modes: &ModeSet,
+        flexible: bool,
+        kernels: &Kernels,
+    ) {
+        let first = if modes.count() > modes.kept() {
+            0
+        } else {
+            first
+        };
         self.flexible = flexible;
         let lanes = padded_lanes(modes.count());
-        for i in 0..self.count {
+        for i in first..self.count {
             let x = self.positions_m[i];
             modes.shape_row(
                 x,
@@ -223,7 +267,7 @@ impl ContactPoints {
         if modes.count() > modes.kept() {
             self.shape_residual_modes(modes, kernels);
         }
-        for i in 0..self.count {
+        for i in first..self.count {
             let row_i = &self.shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + lanes];
             for ((weighted, psi), b) in self.weighted_row.iter_mut().zip(row_i).zip(&modes.b) {
                 *weighted = psi * b;
@@ -370,7 +414,6 @@ mod tests {
             1e-3,
             Some(&thread),
             1e-3,
-            0.0,
             1.0 / 44_100.0,
             -2e-3,
             0.668,
@@ -386,5 +429,58 @@ mod tests {
         // The thread's middle point sits on its top.
         let top = points.bridge_count() + (points.len() - points.bridge_count()) / 2;
         assert!((points.positions_m[top] - thread.position_m).abs() < 1e-12);
+    }
+
+    /// A thread placed anew and coupled from its first point gives the numbers a whole
+    /// placement and coupling give, bit for bit (with the static flexibility's R too).
+    #[test]
+    fn a_thread_placed_anew_couples_as_a_whole_placement_does() {
+        let mut modes = ModeSet::new();
+        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, 20_000.0);
+        let (bridge, thread) = (BridgeSettings::SEED, ThreadSettings::SEED);
+        let kernels = Kernels::detect();
+        let placed = |thread_spacing_m: f64| {
+            let mut points = ContactPoints::with_capacity(64);
+            points.place(
+                &bridge,
+                bridge.start_m,
+                bridge.end_m,
+                2e-3,
+                Some(&thread),
+                thread_spacing_m,
+                1.0 / 44_100.0,
+                -2e-3,
+                0.668,
+            );
+            points.couple(&modes, true, &kernels);
+            points
+        };
+        let mut moved = placed(0.5e-3);
+        moved.place_thread(
+            &bridge,
+            Some(&thread),
+            0.425e-3,
+            1.0 / 44_100.0,
+            -2e-3,
+            0.668,
+        );
+        moved.couple_from(moved.bridge_count(), &modes, true, &kernels);
+        let whole = placed(0.425e-3);
+        assert_eq!(moved.len(), whole.len());
+        assert!(moved.len() > whole.bridge_count() + 11);
+        let n = whole.len();
+        assert_eq!(moved.positions_m[..n], whole.positions_m[..n]);
+        assert_eq!(moved.free_gaps_m[..n], whole.free_gaps_m[..n]);
+        assert_eq!(moved.weights_m[..n], whole.weights_m[..n]);
+        assert_eq!(
+            moved.shapes[..n * MODE_CAPACITY],
+            whole.shapes[..n * MODE_CAPACITY]
+        );
+        for i in 0..n {
+            for j in 0..n {
+                assert_eq!(moved.coupling(i, j), whole.coupling(i, j), "G {i} {j}");
+                assert_eq!(moved.residual(i, j), whole.residual(i, j), "R {i} {j}");
+            }
+        }
     }
 }
