@@ -483,3 +483,49 @@ fn the_thread_lattice_keeps_newton_near_one_update_per_step_at_every_key() {
         worst.0
     );
 }
+
+/// A change of the string's losses alone (γ, η) leaves its rest state, and so the thread's
+/// lattice, where it was: it costs one static solve, where a change that moves the rest state
+/// tries the lattices again (`ModalString::place_thread_lattice`). Keys 40, 59 and 62 of the
+/// live tier, where the configured lattice does not keep the margin. The string it leaves is the
+/// one built for the new losses: the same lattice and the same rest gaps.
+#[test]
+fn a_change_of_the_losses_alone_keeps_the_thread_lattice_with_one_static_solve() {
+    use javari_core::engine::pitch::note_to_hz;
+    use javari_core::tanpura::quality::Quality;
+    use javari_core::tanpura::VoiceSettings;
+    for key in [40u8, 59, 62] {
+        let settings = VoiceSettings {
+            fundamental_hz: note_to_hz(key),
+            ..VoiceSettings::default()
+        };
+        let config = settings
+            .modal_config_at(Quality::Live, SAMPLE_RATE)
+            .expect("the live tier is modal");
+        let mut string = ModalString::<f64>::new(config);
+        let built = string.rest_state_solves();
+        assert!(built > 1, "key {key}: the configured lattice was kept");
+        let mut lossier = config;
+        lossier.string.gamma_per_s *= 2.0;
+        lossier.string.eta_s *= 1.5;
+        assert!(string.set_config(lossier));
+        assert_eq!(string.rest_state_solves(), built + 1, "key {key}");
+        let fresh = ModalString::<f64>::new(lossier);
+        assert_eq!(
+            string.thread_lattice_spacing_m(),
+            fresh.thread_lattice_spacing_m(),
+            "key {key}"
+        );
+        assert_eq!(string.points().len(), fresh.points().len());
+        for i in 0..fresh.points().len() {
+            let (kept, built) = (
+                string.points().rest_gaps_m[i],
+                fresh.points().rest_gaps_m[i],
+            );
+            assert!(
+                (kept - built).abs() < 1e-12,
+                "key {key}, point {i}: {kept} against {built}"
+            );
+        }
+    }
+}

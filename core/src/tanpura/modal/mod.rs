@@ -61,7 +61,7 @@ const RESIDUAL_MODE_RATE_FRACTION: f64 = 0.475;
 /// The thread's lattices tried, in order, as spacings of its points in fractions of the
 /// configured spacing, each with a point on the thread's top (the first the configured one);
 /// [`ModalString::place_thread_lattice`].
-const THREAD_LATTICE_SPACINGS: [f64; 5] = [1.0, 0.9, 1.1, 0.85, 1.15];
+const THREAD_LATTICE_SPACINGS: [f64; 4] = [1.0, 1.1, 1.2, 0.9];
 /// The first lattice whose thread points all lie at least this far from the rest state's
 /// contact edges ([`ModalString::thread_edge_margin`]) is kept.
 const THREAD_EDGE_MARGIN: f64 = 0.35;
@@ -253,6 +253,8 @@ pub struct ModalString<T: Real> {
     cumulative_losses_j: f64,
     external_work_j: f64,
     static_solve_failures: u64,
+    /// Static solves of the rest state since the string was built (the cost of a retune).
+    rest_state_solves: u64,
     non_finite_resets: u64,
 }
 
@@ -292,9 +294,10 @@ impl<T: Real> ModalString<T> {
             cumulative_losses_j: 0.0,
             external_work_j: 0.0,
             static_solve_failures: 0,
+            rest_state_solves: 0,
             non_finite_resets: 0,
         };
-        string.apply_config();
+        string.apply_config(false);
         string.reset();
         string
     }
@@ -324,9 +327,19 @@ impl<T: Real> ModalString<T> {
             self.row[k] = (self.modal[k].to_f64() + self.rest_modal[k]) * scale;
             self.whole_step[k] = T::from_f64(self.velocity[k].to_f64() * scale);
         }
+        // The string's losses (γ, η) do not enter the rest state, so neither the margins nor the
+        // lattice the rule takes: a change of them alone keeps the lattice.
+        let losses_alone = ModalStringConfig {
+            string: StringParameters {
+                gamma_per_s: config.string.gamma_per_s,
+                eta_s: config.string.eta_s,
+                ..self.config.string
+            },
+            ..self.config
+        } == config;
         self.config = config;
-        // Leaves the rest state solved for the new configuration (`place_thread_lattice`).
-        self.apply_config();
+        // Leaves the rest state solved for the new configuration.
+        self.apply_config(losses_alone);
         let count = self.modes.count();
         for k in 0..MODE_CAPACITY {
             let root = if k < count {
@@ -341,7 +354,10 @@ impl<T: Real> ModalString<T> {
         true
     }
 
-    fn apply_config(&mut self) {
+    /// Sets the modes for the configuration and places the points: on the lattice the string
+    /// has with `keep_lattice` (a change that leaves the rest state alone), else on the one
+    /// [`ModalString::place_thread_lattice`] takes. Leaves the rest state solved.
+    fn apply_config(&mut self, keep_lattice: bool) {
         let config = self.config;
         self.modes
             .configure(&config.string, config.time_step_s, config.highest_mode_hz);
@@ -357,7 +373,12 @@ impl<T: Real> ModalString<T> {
             self.b[k] = T::from_f64(self.modes.b[k]);
             self.nut_weights[k] = T::from_f64(self.modes.nut_weight[k]);
         }
-        self.place_thread_lattice();
+        if keep_lattice {
+            self.place_points(self.thread_spacing_m);
+            self.update_rest_state();
+        } else {
+            self.place_thread_lattice();
+        }
     }
 
     /// Places the points, the thread's at the first of [`THREAD_LATTICE_SPACINGS`] whose points
@@ -523,6 +544,7 @@ impl<T: Real> ModalString<T> {
         let count = self.solver.load_points(&self.points);
         let modes = self.modes.count();
         self.solver.forces_n[..count].copy_from_slice(&self.points.rest_forces_n[..count]);
+        self.rest_state_solves += 1;
         if !self.solver.solve(count, modes) {
             self.static_solve_failures += 1;
         }
@@ -955,6 +977,12 @@ impl<T: Real> ModalString<T> {
 
     pub fn static_solve_failures(&self) -> u64 {
         self.static_solve_failures
+    }
+
+    /// Static solves of the rest state since the string was built: one per thread lattice tried
+    /// on each configuration change, one for a change of the losses alone and one per reset.
+    pub fn rest_state_solves(&self) -> u64 {
+        self.rest_state_solves
     }
 
     pub fn non_finite_resets(&self) -> u64 {
