@@ -456,8 +456,10 @@ fn the_thread_lattice_keeps_newton_near_one_update_per_step_at_every_key() {
         if let TierString::Modal(string) = voice.string() {
             let spacing_m = string.thread_lattice_spacing_m();
             eprintln!(
-                "key {key}: thread points {:.3} mm apart, {updates:.3} updates per step",
-                spacing_m * 1e3
+                "key {key}: thread points {:.3} mm apart, {:.3} mm off the top, \
+                 {updates:.3} updates per step",
+                spacing_m * 1e3,
+                string.thread_lattice_offset_m() * 1e3
             );
             if key == 59 || key == 60 {
                 assert_ne!(
@@ -514,6 +516,11 @@ fn a_change_of_the_losses_alone_keeps_the_thread_lattice_with_one_static_solve()
         assert_eq!(
             string.thread_lattice_spacing_m(),
             fresh.thread_lattice_spacing_m(),
+            "key {key}"
+        );
+        assert_eq!(
+            string.thread_lattice_offset_m(),
+            fresh.thread_lattice_offset_m(),
             "key {key}"
         );
         assert_eq!(string.points().len(), fresh.points().len());

@@ -58,10 +58,36 @@ const MAX_FINGER_WIDTH_M: f64 = 0.040;
 /// The residual modes ring at this fraction of the sample rate: above the kept modes (at most
 /// 0.45 of it) and below Nyquist.
 const RESIDUAL_MODE_RATE_FRACTION: f64 = 0.475;
-/// The thread's lattices tried, in order, as spacings of its points in fractions of the
-/// configured spacing, each with a point on the thread's top (the first the configured one);
-/// [`ModalString::place_thread_lattice`].
-const THREAD_LATTICE_SPACINGS: [f64; 4] = [1.0, 1.1, 1.2, 0.9];
+/// The thread's lattices tried, in order, as the spacing of its points in fractions of the
+/// configured spacing and their offset from the thread's top in fractions of that spacing:
+/// the configured lattice with a point on the top, two coarser ones on the top, and the
+/// configured one straddling the top; [`ModalString::place_thread_lattice`].
+const THREAD_LATTICES: [ThreadLattice; 4] = [
+    ThreadLattice {
+        spacing: 1.0,
+        offset: 0.0,
+    },
+    ThreadLattice {
+        spacing: 1.1,
+        offset: 0.0,
+    },
+    ThreadLattice {
+        spacing: 1.2,
+        offset: 0.0,
+    },
+    ThreadLattice {
+        spacing: 1.0,
+        offset: 0.5,
+    },
+];
+
+/// A lattice of the thread's points: their spacing, in fractions of the configured spacing, and
+/// their offset from the thread's top, in fractions of that spacing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ThreadLattice {
+    spacing: f64,
+    offset: f64,
+}
 /// The first lattice whose thread points all lie at least this far from the rest state's
 /// contact edges ([`ModalString::thread_edge_margin`]) is kept.
 const THREAD_EDGE_MARGIN: f64 = 0.35;
@@ -191,8 +217,9 @@ impl ModalStringConfig {
             .half_width_m()
             .max(self.thread.map_or(0.0, |thread| thread.half_width_m()));
         // Room for the finest lattice tried.
-        let finest = THREAD_LATTICE_SPACINGS
-            .into_iter()
+        let finest = THREAD_LATTICES
+            .iter()
+            .map(|lattice| lattice.spacing)
             .fold(f64::INFINITY, f64::min);
         let finest_spacing_m = finest * self.thread_point_spacing_m;
         let thread = 2 * (half_width / finest_spacing_m).floor() as usize + 1;
@@ -234,8 +261,10 @@ pub struct ModalString<T: Real> {
     points: ContactPoints,
     /// ‖Ψ_i‖ per point (every mode the step advances), m/√J: what bounds a point's reach.
     shape_norms: Vec<f64>,
-    /// The thread's points' spacing, m ([`ModalString::place_thread_lattice`]).
+    /// The thread's points' spacing and offset from its top, m
+    /// ([`ModalString::place_thread_lattice`]).
     thread_spacing_m: f64,
+    thread_offset_m: f64,
     /// Steps since far points were last put to sleep.
     steps_since_sleep_check: usize,
     contact: ContactStep,
@@ -279,6 +308,7 @@ impl<T: Real> ModalString<T> {
             points: ContactPoints::with_capacity(points),
             shape_norms: vec![0.0; points],
             thread_spacing_m: config.thread_point_spacing_m,
+            thread_offset_m: 0.0,
             steps_since_sleep_check: 0,
             contact: ContactStep::new(points),
             solver: StaticSolver::new(points + finger),
@@ -374,14 +404,14 @@ impl<T: Real> ModalString<T> {
             self.nut_weights[k] = T::from_f64(self.modes.nut_weight[k]);
         }
         if keep_lattice {
-            self.place_points(self.thread_spacing_m);
+            self.place_points(self.thread_spacing_m, self.thread_offset_m);
             self.update_rest_state();
         } else {
             self.place_thread_lattice();
         }
     }
 
-    /// Places the points, the thread's at the first of [`THREAD_LATTICE_SPACINGS`] whose points
+    /// Places the points, the thread's at the first of [`THREAD_LATTICES`] whose points
     /// all keep [`THREAD_EDGE_MARGIN`] from the rest state's contact edges (the first at once
     /// without a thread: its margin is infinite), or at the one with the largest margin; leaves
     /// the rest state solved on the lattice it keeps, one static solve per lattice tried.
@@ -390,24 +420,24 @@ impl<T: Real> ModalString<T> {
     /// or barely clear) enters and leaves contact with the smallest vibration, so the contact
     /// solve takes a second Newton update in many steps; which points lie there depends on where
     /// the lattice falls against the contact region, which moves with the string's tension. At
-    /// the live tier's 0.5 mm points, over 1 s of the one-string scene: key 59 takes 1.654
-    /// updates per step with a point on the thread's top and 1.080 with the lattice straddling
-    /// it, key 51 1.046 and 1.797 (`docs/performance.md`, "Stop 38"). Every lattice keeps a point
-    /// on the thread's top, where the string presses hardest, and changes its spacing: over the
-    /// bench's playing range, against the string refined fourfold, that moves keys 59–64 by
-    /// half as much in band levels as stop 38's shifted lattices did (+0.37 dB against +0.71;
-    /// `docs/performance.md`, "Stop 39"). The lattice is a function of the configuration alone
-    /// (the order of the spacings tried is fixed). Allocation-free; a retune solves the rest
-    /// state once per lattice tried (once where the first is kept).
+    /// the live tier's 0.5 mm points, over 1 s of the one-string scene, key 59 takes 1.654
+    /// updates per step and 1.062 at 0.55 mm; over keys 36–64 the rule's most is 1.086 (key 61;
+    /// `docs/performance.md`, "Stop 39"). Every lattice keeps a point on the thread's top, where
+    /// the string presses hardest; none is finer than 0.9 of the configured spacing, since more
+    /// points cost more per update, and the coarser come first. The lattice is a function of the
+    /// configuration alone (the order of the spacings tried is fixed). Allocation-free; a retune
+    /// solves the rest state once per lattice tried (once where the first is kept), and a lattice
+    /// after the first re-places and re-couples the thread's points alone.
     fn place_thread_lattice(&mut self) {
         let configured_m = self.config.thread_point_spacing_m;
-        let mut best = (f64::NEG_INFINITY, configured_m);
-        for (tried, fraction) in THREAD_LATTICE_SPACINGS.into_iter().enumerate() {
-            let spacing_m = fraction * configured_m;
+        let mut best = (f64::NEG_INFINITY, configured_m, 0.0);
+        for (tried, lattice) in THREAD_LATTICES.into_iter().enumerate() {
+            let spacing_m = lattice.spacing * configured_m;
+            let offset_m = lattice.offset * spacing_m;
             if tried == 0 {
-                self.place_points(spacing_m);
+                self.place_points(spacing_m, offset_m);
             } else {
-                self.place_thread_points(spacing_m);
+                self.place_thread_points(spacing_m, offset_m);
             }
             self.update_rest_state();
             let margin = self.thread_edge_margin();
@@ -415,11 +445,11 @@ impl<T: Real> ModalString<T> {
                 return;
             }
             if margin > best.0 {
-                best = (margin, spacing_m);
+                best = (margin, spacing_m, offset_m);
             }
         }
-        if best.1 != self.thread_spacing_m {
-            self.place_thread_points(best.1);
+        if (best.1, best.2) != (self.thread_spacing_m, self.thread_offset_m) {
+            self.place_thread_points(best.1, best.2);
             self.update_rest_state();
         }
     }
@@ -458,10 +488,17 @@ impl<T: Real> ModalString<T> {
         self.thread_spacing_m
     }
 
-    /// Places the points (the thread's `thread_spacing_m` apart) and couples them to the modes.
-    fn place_points(&mut self, thread_spacing_m: f64) {
+    /// The thread's points' offset from its top, m (0: a point on the top).
+    pub fn thread_lattice_offset_m(&self) -> f64 {
+        self.thread_offset_m
+    }
+
+    /// Places the points (the thread's `thread_spacing_m` apart, `thread_offset_m` from its
+    /// top) and couples them to the modes.
+    fn place_points(&mut self, thread_spacing_m: f64, thread_offset_m: f64) {
         let config = self.config;
         self.thread_spacing_m = thread_spacing_m;
+        self.thread_offset_m = thread_offset_m;
         self.points.place(
             &config.bridge,
             config.bridge_start_m(),
@@ -469,6 +506,7 @@ impl<T: Real> ModalString<T> {
             config.bridge_point_spacing_m,
             config.thread.as_ref(),
             thread_spacing_m,
+            thread_offset_m,
             config.time_step_s,
             config.string.left_support_m,
             config.string.length_m,
@@ -476,15 +514,18 @@ impl<T: Real> ModalString<T> {
         self.couple_points_from(0);
     }
 
-    /// Places the thread's points anew, `thread_spacing_m` apart, after [`Self::place_points`]
-    /// for the same configuration: the bridge's points and their coupling stay.
-    fn place_thread_points(&mut self, thread_spacing_m: f64) {
+    /// Places the thread's points anew (`thread_spacing_m` apart, `thread_offset_m` from its
+    /// top) after [`Self::place_points`] for the same configuration: the bridge's points and
+    /// their coupling stay.
+    fn place_thread_points(&mut self, thread_spacing_m: f64, thread_offset_m: f64) {
         let config = self.config;
         self.thread_spacing_m = thread_spacing_m;
+        self.thread_offset_m = thread_offset_m;
         self.points.place_thread(
             &config.bridge,
             config.thread.as_ref(),
             thread_spacing_m,
+            thread_offset_m,
             config.time_step_s,
             config.string.left_support_m,
             config.string.length_m,

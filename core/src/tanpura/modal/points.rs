@@ -122,8 +122,9 @@ impl ContactPoints {
     }
 
     /// Places the points on bridge and thread (a point per `spacing` over the part of each
-    /// barrier with a positive stiffness; the thread's symmetric about its top, with a point on
-    /// the top) and sets their laws for the step `time_step_s`. Points beyond the capacity are
+    /// barrier with a positive stiffness; the thread's lattice `thread_offset_m` from its top,
+    /// which with 0 is symmetric about it with a point on the top) and sets their laws for the
+    /// step `time_step_s`. Points beyond the capacity are
     /// dropped. `left_support_m` and `length_m` give the line y_s. Allocation-free.
     #[allow(clippy::too_many_arguments)]
     pub fn place(
@@ -134,6 +135,7 @@ impl ContactPoints {
         bridge_spacing_m: f64,
         thread: Option<&ThreadSettings>,
         thread_spacing_m: f64,
+        thread_offset_m: f64,
         time_step_s: f64,
         left_support_m: f64,
         length_m: f64,
@@ -162,20 +164,24 @@ impl ContactPoints {
             bridge,
             thread,
             thread_spacing_m,
+            thread_offset_m,
             time_step_s,
             left_support_m,
             length_m,
         );
     }
 
-    /// Places the thread's points anew, `thread_spacing_m` apart, and keeps the bridge's (the
+    /// Places the thread's points anew, `thread_spacing_m` apart and `thread_offset_m` from its
+    /// top, and keeps the bridge's (the
     /// points `0..bridge_count()` from the last [`ContactPoints::place`]): the rest of `place`.
     /// Allocation-free.
+    #[allow(clippy::too_many_arguments)]
     pub fn place_thread(
         &mut self,
         bridge: &BridgeSettings,
         thread: Option<&ThreadSettings>,
         thread_spacing_m: f64,
+        thread_offset_m: f64,
         time_step_s: f64,
         left_support_m: f64,
         length_m: f64,
@@ -184,7 +190,9 @@ impl ContactPoints {
         if let Some(thread) = thread.filter(|thread| thread.stiffness_n_m2 > 0.0) {
             let side = (thread.half_width_m() / thread_spacing_m).floor() as usize;
             for index in 0..2 * side + 1 {
-                let x = thread.position_m + (index as f64 - side as f64) * thread_spacing_m;
+                let x = thread.position_m
+                    + thread_offset_m
+                    + (index as f64 - side as f64) * thread_spacing_m;
                 self.push(
                     x,
                     thread.height_over(bridge, x),
@@ -414,6 +422,7 @@ mod tests {
             1e-3,
             Some(&thread),
             1e-3,
+            0.0,
             1.0 / 44_100.0,
             -2e-3,
             0.668,
@@ -448,6 +457,7 @@ mod tests {
                 2e-3,
                 Some(&thread),
                 thread_spacing_m,
+                0.0,
                 1.0 / 44_100.0,
                 -2e-3,
                 0.668,
