@@ -428,8 +428,8 @@ fn residual_mode_shapes_are_the_leading_part_of_the_truncated_compliance() {
 /// 36–64. With the lattice fixed at 0.5 mm on the thread's top, key 59 took 1.620 updates per
 /// step (at rest one of its thread points barely touched, 0.005 N, and its neighbour lay 1.1 µm
 /// clear); with stop 38's rule (the lattice shifted off the top) the most was 1.181 (key 58);
-/// with the spacing chosen per string it is 1.097 (key 44), and keys 59 and 60 change the
-/// spacing (`ModalString::thread_lattice_spacing_m`).
+/// with stop 39's (coarser lattices on the top first) it is 1.071 (key 62), and keys 59 and 60
+/// take a coarser lattice on the top (`ModalString::thread_lattice_spacing_m`).
 #[test]
 fn the_thread_lattice_keeps_newton_near_one_update_per_step_at_every_key() {
     use javari_core::engine::pitch::note_to_hz;
@@ -469,6 +469,7 @@ fn the_thread_lattice_keeps_newton_near_one_update_per_step_at_every_key() {
             }
             if key == 55 {
                 assert_eq!(spacing_m, 0.5e-3);
+                assert_eq!(string.thread_lattice_offset_m(), 0.0);
             }
         } else {
             panic!("the live tier is modal");

@@ -411,9 +411,9 @@ impl<T: Real> ModalString<T> {
         }
     }
 
-    /// Places the points, the thread's at the first of [`THREAD_LATTICES`] whose points
-    /// all keep [`THREAD_EDGE_MARGIN`] from the rest state's contact edges (the first at once
-    /// without a thread: its margin is infinite), or at the one with the largest margin; leaves
+    /// Places the points, the thread's on the first of [`THREAD_LATTICES`] whose points all
+    /// keep [`THREAD_EDGE_MARGIN`] from the rest state's contact edges (the first at once
+    /// without a thread: its margin is infinite), or on the one with the largest margin; leaves
     /// the rest state solved on the lattice it keeps, one static solve per lattice tried.
     ///
     /// A thread point that lies at the edge of the string's contact at rest (barely touching,
@@ -421,13 +421,12 @@ impl<T: Real> ModalString<T> {
     /// solve takes a second Newton update in many steps; which points lie there depends on where
     /// the lattice falls against the contact region, which moves with the string's tension. At
     /// the live tier's 0.5 mm points, over 1 s of the one-string scene, key 59 takes 1.654
-    /// updates per step and 1.062 at 0.55 mm; over keys 36–64 the rule's most is 1.086 (key 61;
-    /// `docs/performance.md`, "Stop 39"). Every lattice keeps a point on the thread's top, where
-    /// the string presses hardest; none is finer than 0.9 of the configured spacing, since more
-    /// points cost more per update, and the coarser come first. The lattice is a function of the
-    /// configuration alone (the order of the spacings tried is fixed). Allocation-free; a retune
-    /// solves the rest state once per lattice tried (once where the first is kept), and a lattice
-    /// after the first re-places and re-couples the thread's points alone.
+    /// updates per step on the top and 1.062 at 0.55 mm; over keys 36–64 the rule's most is
+    /// 1.065 (key 60; `docs/performance.md`, "Stop 39"). No lattice tried is finer than the
+    /// configured one: more points cost more per update. The lattice is a function of the
+    /// configuration alone (the order of the lattices tried is fixed). Allocation-free; a retune
+    /// solves the rest state once per lattice tried (once where the first is kept), and a
+    /// lattice after the first re-places and re-couples the thread's points alone.
     fn place_thread_lattice(&mut self) {
         let configured_m = self.config.thread_point_spacing_m;
         let mut best = (f64::NEG_INFINITY, configured_m, 0.0);
