@@ -496,27 +496,33 @@ impl<T: Real> ModalString<T> {
     /// top) and couples them to the modes.
     fn place_points(&mut self, thread_spacing_m: f64, thread_offset_m: f64) {
         let config = self.config;
-        self.thread_spacing_m = thread_spacing_m;
-        self.thread_offset_m = thread_offset_m;
-        self.points.place(
+        self.points.place_bridge(
             &config.bridge,
             config.bridge_start_m(),
             config.bridge_end_m(),
             config.bridge_point_spacing_m,
-            config.thread.as_ref(),
-            thread_spacing_m,
-            thread_offset_m,
             config.time_step_s,
             config.string.left_support_m,
             config.string.length_m,
         );
-        self.couple_points_from(0);
+        self.place_thread_coupling_from(thread_spacing_m, thread_offset_m, 0);
     }
 
     /// Places the thread's points anew (`thread_spacing_m` apart, `thread_offset_m` from its
     /// top) after [`Self::place_points`] for the same configuration: the bridge's points and
     /// their coupling stay.
     fn place_thread_points(&mut self, thread_spacing_m: f64, thread_offset_m: f64) {
+        let first = self.points.bridge_count();
+        self.place_thread_coupling_from(thread_spacing_m, thread_offset_m, first);
+    }
+
+    /// Places the thread's points after the bridge's and couples the points `first..`.
+    fn place_thread_coupling_from(
+        &mut self,
+        thread_spacing_m: f64,
+        thread_offset_m: f64,
+        first: usize,
+    ) {
         let config = self.config;
         self.thread_spacing_m = thread_spacing_m;
         self.thread_offset_m = thread_offset_m;
@@ -529,7 +535,7 @@ impl<T: Real> ModalString<T> {
             config.string.left_support_m,
             config.string.length_m,
         );
-        self.couple_points_from(self.points.bridge_count());
+        self.couple_points_from(first);
     }
 
     /// Couples the points `first..` to the modes (those before unchanged since they were).

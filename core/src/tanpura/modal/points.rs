@@ -121,21 +121,18 @@ impl ContactPoints {
         self.coupling[i * self.capacity + j]
     }
 
-    /// Places the points on bridge and thread (a point per `spacing` over the part of each
-    /// barrier with a positive stiffness; the thread's lattice `thread_offset_m` from its top,
-    /// which with 0 is symmetric about it with a point on the top) and sets their laws for the
-    /// step `time_step_s`. Points beyond the capacity are
-    /// dropped. `left_support_m` and `length_m` give the line y_s. Allocation-free.
+    /// Places the bridge's points (a point per `bridge_spacing_m` over the part of the bridge
+    /// between `bridge_start_m` and `bridge_end_m`, if its stiffness is positive) and sets their
+    /// laws for the step `time_step_s`; the thread's follow by [`ContactPoints::place_thread`].
+    /// Points beyond the capacity are dropped. `left_support_m` and `length_m` give the line
+    /// y_s. Allocation-free.
     #[allow(clippy::too_many_arguments)]
-    pub fn place(
+    pub fn place_bridge(
         &mut self,
         bridge: &BridgeSettings,
         bridge_start_m: f64,
         bridge_end_m: f64,
         bridge_spacing_m: f64,
-        thread: Option<&ThreadSettings>,
-        thread_spacing_m: f64,
-        thread_offset_m: f64,
         time_step_s: f64,
         left_support_m: f64,
         length_m: f64,
@@ -156,24 +153,13 @@ impl ContactPoints {
             }
         }
         self.bridge_count = self.count;
-        for i in 0..self.bridge_count {
-            let line = left_support_m * (1.0 - self.positions_m[i] / length_m);
-            self.free_gaps_m[i] = self.heights_m[i] - line;
-        }
-        self.place_thread(
-            bridge,
-            thread,
-            thread_spacing_m,
-            thread_offset_m,
-            time_step_s,
-            left_support_m,
-            length_m,
-        );
+        self.set_free_gaps(0, left_support_m, length_m);
     }
 
-    /// Places the thread's points anew, `thread_spacing_m` apart and `thread_offset_m` from its
-    /// top, and keeps the bridge's (the
-    /// points `0..bridge_count()` from the last [`ContactPoints::place`]): the rest of `place`.
+    /// Places the thread's points (over the part of its cap above the bridge, if its stiffness
+    /// is positive), `thread_spacing_m` apart and `thread_offset_m` from its top (0: symmetric
+    /// about the top with a point on it), after the bridge's points of the last
+    /// [`ContactPoints::place_bridge`], which stay; as many times as lattices are tried.
     /// Allocation-free.
     #[allow(clippy::too_many_arguments)]
     pub fn place_thread(
@@ -203,7 +189,12 @@ impl ContactPoints {
                 );
             }
         }
-        for i in self.bridge_count..self.count {
+        self.set_free_gaps(self.bridge_count, left_support_m, length_m);
+    }
+
+    /// g_i = h_i − y_s(x_i) for the points `first..`.
+    fn set_free_gaps(&mut self, first: usize, left_support_m: f64, length_m: f64) {
+        for i in first..self.count {
             let line = left_support_m * (1.0 - self.positions_m[i] / length_m);
             self.free_gaps_m[i] = self.heights_m[i] - line;
         }
@@ -236,7 +227,7 @@ impl ContactPoints {
     }
 
     /// Recomputes Ψ (with the residual modes' columns, if `modes` has any), G and (with
-    /// `flexible`) R for the modes (after [`ContactPoints::place`] or a change of the string's
+    /// `flexible`) R for the modes (after placing the points or a change of the string's
     /// parameters). Allocation-free; O(M K + M² K), the M² K part as
     /// SIMD dot products (`kernels.dots_pair`): each row i of G and of Ψ Ψᵀ up to the diagonal
     /// is `Ψ_j · (Ψ_i ⊙ b)` and `Ψ_j · Ψ_i` for j ≤ i. It runs on every retune of a ringing
@@ -408,25 +399,42 @@ mod tests {
     use super::*;
     use crate::tanpura::string::StringParameters;
 
+    /// The seed's bridge and thread at 44.1 kHz, placed (not coupled).
+    fn seed_points(
+        bridge_spacing_m: f64,
+        thread_spacing_m: f64,
+        thread_offset_m: f64,
+    ) -> ContactPoints {
+        let (bridge, thread) = (BridgeSettings::SEED, ThreadSettings::SEED);
+        let (time_step_s, left_support_m, length_m) = (1.0 / 44_100.0, -2e-3, 0.668);
+        let mut points = ContactPoints::with_capacity(64);
+        points.place_bridge(
+            &bridge,
+            bridge.start_m,
+            bridge.end_m,
+            bridge_spacing_m,
+            time_step_s,
+            left_support_m,
+            length_m,
+        );
+        points.place_thread(
+            &bridge,
+            Some(&thread),
+            thread_spacing_m,
+            thread_offset_m,
+            time_step_s,
+            left_support_m,
+            length_m,
+        );
+        points
+    }
+
     #[test]
     fn coupling_is_symmetric_and_its_diagonal_positive() {
         let mut modes = ModeSet::new();
         modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, 20_000.0);
-        let mut points = ContactPoints::with_capacity(64);
-        let bridge = BridgeSettings::SEED;
         let thread = ThreadSettings::SEED;
-        points.place(
-            &bridge,
-            bridge.start_m,
-            bridge.end_m,
-            1e-3,
-            Some(&thread),
-            1e-3,
-            0.0,
-            1.0 / 44_100.0,
-            -2e-3,
-            0.668,
-        );
+        let mut points = seed_points(1e-3, 1e-3, 0.0);
         points.couple(&modes, true, &Kernels::detect());
         assert!(points.len() > 30);
         for i in 0..points.len() {
@@ -450,19 +458,7 @@ mod tests {
         let (bridge, thread) = (BridgeSettings::SEED, ThreadSettings::SEED);
         let kernels = Kernels::detect();
         let placed = |thread_spacing_m: f64, thread_offset_m: f64| {
-            let mut points = ContactPoints::with_capacity(64);
-            points.place(
-                &bridge,
-                bridge.start_m,
-                bridge.end_m,
-                2e-3,
-                Some(&thread),
-                thread_spacing_m,
-                thread_offset_m,
-                1.0 / 44_100.0,
-                -2e-3,
-                0.668,
-            );
+            let mut points = seed_points(2e-3, thread_spacing_m, thread_offset_m);
             points.couple(&modes, true, &kernels);
             points
         };
