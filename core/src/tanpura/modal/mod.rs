@@ -88,6 +88,7 @@ struct ThreadLattice {
     spacing: f64,
     offset: f64,
 }
+
 /// The first lattice whose thread points all lie at least this far from the rest state's
 /// contact edges ([`ModalString::thread_edge_margin`]) is kept.
 const THREAD_EDGE_MARGIN: f64 = 0.35;
