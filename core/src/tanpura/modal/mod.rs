@@ -83,7 +83,7 @@ const THREAD_LATTICES: [ThreadLattice; 4] = [
 
 /// A lattice of the thread's points: their spacing, in fractions of the configured spacing, and
 /// their offset from the thread's top, in fractions of that spacing.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 struct ThreadLattice {
     spacing: f64,
     offset: f64,
@@ -541,18 +541,13 @@ impl<T: Real> ModalString<T> {
 
     /// Couples the points `first..` to the modes (those before unchanged since they were).
     fn couple_points_from(&mut self, first: usize) {
-        self.points.couple_from(
+        // From 0 with residual modes (`ContactPoints::couple_from`).
+        let first = self.points.couple_from(
             first,
             &self.modes,
             self.config.static_flexibility,
             &self.kernels,
         );
-        // With residual modes every point's row changed (`ContactPoints::couple_from`).
-        let first = if self.modes.count() > self.modes.kept() {
-            0
-        } else {
-            first
-        };
         let rows = first * MODE_CAPACITY..;
         for (target, source) in self.shapes[rows.clone()]
             .iter_mut()

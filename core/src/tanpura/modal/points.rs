@@ -227,28 +227,23 @@ impl ContactPoints {
     }
 
     /// Recomputes Ψ (with the residual modes' columns, if `modes` has any), G and (with
-    /// `flexible`) R for the modes (after placing the points or a change of the string's
-    /// parameters). Allocation-free; O(M K + M² K), the M² K part as
-    /// SIMD dot products (`kernels.dots_pair`): each row i of G and of Ψ Ψᵀ up to the diagonal
-    /// is `Ψ_j · (Ψ_i ⊙ b)` and `Ψ_j · Ψ_i` for j ≤ i. It runs on every retune of a ringing
-    /// string (each tuning pass), so it is on the audio thread's path.
-    pub fn couple(&mut self, modes: &ModeSet, flexible: bool, kernels: &Kernels) {
-        self.couple_from(0, modes, flexible, kernels);
-    }
-
-    /// [`ContactPoints::couple`] for the points `first..` alone, whose positions changed while
-    /// those before kept theirs and their coupling (a thread placed anew by
-    /// [`ContactPoints::place_thread`] after `couple`, the modes unchanged): the rows of Ψ, G
-    /// and R from `first` on, which also holds the columns below `first` by symmetry; the same
-    /// numbers `couple` gives, at a fraction of its cost. The residual modes' shapes depend on
-    /// every point, so with residual modes it couples them all.
+    /// `flexible`) R for the modes, from point `first` on: 0 after placing the points or a
+    /// change of the string's parameters, `bridge_count()` after a thread placed anew by
+    /// [`ContactPoints::place_thread`] (the points before `first` and the modes unchanged since
+    /// they were coupled). The rows from `first` on hold the columns below it by symmetry, so
+    /// the numbers are a whole coupling's. The residual modes' shapes depend on every point, so
+    /// with residual modes it couples them all. Returns the first point whose row it recomputed.
+    /// Allocation-free; O(M K + M² K), the M² K part as SIMD dot products
+    /// (`kernels.dots_pair`): each row i of G and of Ψ Ψᵀ up to the diagonal is
+    /// `Ψ_j · (Ψ_i ⊙ b)` and `Ψ_j · Ψ_i` for j ≤ i. It runs on every retune of a ringing string
+    /// (each tuning pass), so it is on the audio thread's path.
     pub fn couple_from(
         &mut self,
         first: usize,
         modes: &ModeSet,
         flexible: bool,
         kernels: &Kernels,
-    ) {
+    ) -> usize {
         let first = if modes.count() > modes.kept() {
             0
         } else {
@@ -294,6 +289,7 @@ impl ContactPoints {
                 self.residual[j * self.capacity + i] = residual;
             }
         }
+        first
     }
 
     /// The residual modes' shapes at the points (`docs/modal-tanpura.md`, section 8): the
@@ -435,7 +431,7 @@ mod tests {
         modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, 20_000.0);
         let thread = ThreadSettings::SEED;
         let mut points = seed_points(1e-3, 1e-3, 0.0);
-        points.couple(&modes, true, &Kernels::detect());
+        points.couple_from(0, &modes, true, &Kernels::detect());
         assert!(points.len() > 30);
         for i in 0..points.len() {
             assert!(points.coupling(i, i) > 0.0);
@@ -459,7 +455,7 @@ mod tests {
         let kernels = Kernels::detect();
         let placed = |thread_spacing_m: f64, thread_offset_m: f64| {
             let mut points = seed_points(2e-3, thread_spacing_m, thread_offset_m);
-            points.couple(&modes, true, &kernels);
+            points.couple_from(0, &modes, true, &kernels);
             points
         };
         let mut moved = placed(0.5e-3, 0.0);
@@ -472,7 +468,8 @@ mod tests {
             -2e-3,
             0.668,
         );
-        moved.couple_from(moved.bridge_count(), &modes, true, &kernels);
+        let recoupled = moved.couple_from(moved.bridge_count(), &modes, true, &kernels);
+        assert_eq!(recoupled, moved.bridge_count());
         let whole = placed(0.55e-3, 0.275e-3);
         assert_eq!(moved.len(), whole.len());
         assert_eq!(moved.len(), whole.bridge_count() + 9);
