@@ -7,14 +7,17 @@
 //! yardstick moves when refined twice more, at six plucks; `-- --space-time KEY VELOCITY
 //! POSITION_M` how far the seed's scheme lies from it at one pluck on grids refined in space or
 //! in time alone; `-- --live-variants KEY VELOCITY POSITION_M` the live tier's string with a
-//! shorter time step or other bridge points. `cargo xtask bench` measures the same without
-//! the residual modes, and caches the refined renders.
+//! shorter time step or other bridge points; `-- --rate-grid` the live tier's string with and
+//! without two residual modes, at the output rate and at four times it, over the whole grid
+//! against the refined string and against the reference (both tuned by linearisation; about
+//! five minutes on two cores). `cargo xtask bench` measures the same without the residual
+//! modes, and caches the refined renders.
 //!
 //! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
 //! tier tuned by linearising about its own rest state (no calibration as played), so that the
 //! schemes are compared at equal physical parameters; the refined string is tuned and plucked
 //! the same way. The four measures are the bench's (`analysis::listening::compare`). The figures
-//! are quoted in `docs/modal-tanpura.md`, section 9 ("Stop 35").
+//! are quoted in `docs/modal-tanpura.md`, section 9 ("Stop 35"; `--rate-grid`: "Stop 40").
 
 use javari_core::analysis::listening::{compare, ListeningDifference};
 use javari_core::analysis::playing_range::{full_grid, GridPoint};
@@ -54,6 +57,111 @@ fn residual_modes(args: &[String]) -> usize {
                 .and_then(|n| n.parse().ok())
                 .expect("--residual-modes takes a count")
         })
+}
+
+/// `measure` of every point, on all cores, in the points' order.
+fn measure_all<T: Send>(points: &[GridPoint], measure: impl Fn(&GridPoint) -> T + Sync) -> Vec<T> {
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut results: Vec<(usize, T)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut mine = Vec::new();
+                    loop {
+                        let index = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(point) = points.get(index) else {
+                            break mine;
+                        };
+                        mine.push((index, measure(point)));
+                    }
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|handle| handle.join().expect("a worker panicked"))
+            .collect()
+    });
+    results.sort_by_key(|(index, _)| *index);
+    results.into_iter().map(|(_, result)| result).collect()
+}
+
+/// Worst and median of each measure over the plucks: (pitch, cents), (band levels, dB),
+/// (centroid course, %).
+fn summary(differences: &[&ListeningDifference]) -> [(f64, f64); 3] {
+    let measures: [fn(&ListeningDifference) -> f64; 3] = [
+        |d| d.sustained_cents.abs(),
+        |d| d.band_level_db,
+        |d| 100.0 * d.centroid_error,
+    ];
+    measures.map(|measure| {
+        let values: Vec<f64> = differences.iter().map(|d| measure(d)).collect();
+        let worst = values.iter().copied().fold(0.0, f64::max);
+        (worst, median(values))
+    })
+}
+
+/// `--rate-grid`: the live tier's string with and without two residual modes, at the output
+/// rate and at four times it (`refined::modal_variant_pluck`, decimated as the FD tiers are),
+/// over the whole grid, against N = 800 at 16× and against the reference, all tuned by
+/// linearisation (`docs/modal-tanpura.md`, "Stop 40").
+fn rate_grid() {
+    const VARIANTS: [(usize, usize); 4] = [(0, 1), (0, 4), (2, 1), (2, 4)];
+    let points = full_grid();
+    let results = measure_all(&points, |point| {
+        let refined = grid_render_refined(point, SAMPLE_RATE_HZ);
+        let reference = grid_render_linearised(Quality::Reference, point, SAMPLE_RATE_HZ, 0);
+        let (settings, pluck) = grid_pluck(Quality::Live, point);
+        let nominal = point.nominal_hz();
+        VARIANTS.map(|(residual_modes, oversample)| {
+            let variant = ModalVariant {
+                residual_modes,
+                oversample,
+                ..ModalVariant::default()
+            };
+            let output = modal_variant_pluck(
+                &settings,
+                &variant,
+                &pluck,
+                javari_core::analysis::playing_range::NOTE_SECONDS,
+                SAMPLE_RATE_HZ,
+            )
+            .expect("the live tier is modal");
+            (
+                compare(&output, &refined, SAMPLE_RATE_HZ, nominal),
+                compare(&output, &reference, SAMPLE_RATE_HZ, nominal),
+            )
+        })
+    });
+    println!(
+        "The live tier's string over {} plucks, worst / median (pitch cents, band levels dB, \
+         centroid %):",
+        points.len()
+    );
+    for (column, (residual_modes, oversample)) in VARIANTS.iter().enumerate() {
+        let against = |which: usize| {
+            let differences: Vec<&ListeningDifference> = results
+                .iter()
+                .map(|row| {
+                    if which == 0 {
+                        &row[column].0
+                    } else {
+                        &row[column].1
+                    }
+                })
+                .collect();
+            summary(&differences)
+                .map(|(worst, median)| format!("{worst:5.2} / {median:4.2}"))
+                .join(", ")
+        };
+        println!(
+            "{residual_modes} residual modes at {oversample}x | against N = 800: {} | against \
+             the reference: {}",
+            against(0),
+            against(1)
+        );
+    }
 }
 
 /// The upper median, as the bench takes it.
@@ -269,6 +377,10 @@ fn main() {
         live_variants(&args);
         return;
     }
+    if args.iter().any(|arg| arg == "--rate-grid") {
+        rate_grid();
+        return;
+    }
     let residual_modes = residual_modes(&args);
     let positions: Option<Vec<f64>> =
         args.get(1)
@@ -287,29 +399,11 @@ fn main() {
             })
         })
         .collect();
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut results: Vec<(usize, Vec<ListeningDifference>)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut mine = Vec::new();
-                    loop {
-                        let index = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(point) = points.get(index) else {
-                            break mine;
-                        };
-                        mine.push((index, measure(point, residual_modes)));
-                    }
-                })
-            })
-            .collect();
-        handles
+    let results: Vec<(usize, Vec<ListeningDifference>)> =
+        measure_all(&points, |point| measure(point, residual_modes))
             .into_iter()
-            .flat_map(|handle| handle.join().expect("a worker panicked"))
-            .collect()
-    });
-    results.sort_by_key(|(index, _)| *index);
+            .enumerate()
+            .collect();
 
     let (intervals, oversample) = yardstick_grid();
     println!(
@@ -335,19 +429,11 @@ fn main() {
     }
     println!("\nWorst / median over {} plucks:", results.len());
     for (tier, quality) in TIERS.iter().enumerate() {
-        let column = |measure: fn(&ListeningDifference) -> f64| -> Vec<f64> {
-            results
-                .iter()
-                .map(|(_, differences)| measure(&differences[tier]))
-                .collect()
-        };
-        let summary = |values: Vec<f64>| {
-            let worst = values.iter().copied().fold(0.0, f64::max);
-            (worst, median(values))
-        };
-        let pitch = summary(column(|d| d.sustained_cents.abs()));
-        let bands = summary(column(|d| d.band_level_db));
-        let centroid = summary(column(|d| 100.0 * d.centroid_error));
+        let column: Vec<&ListeningDifference> = results
+            .iter()
+            .map(|(_, differences)| &differences[tier])
+            .collect();
+        let [pitch, bands, centroid] = summary(&column);
         let nearer = results
             .iter()
             .filter(|(_, d)| d[tier].band_level_db < d[0].band_level_db)
