@@ -26,7 +26,9 @@ use javari_core::analysis::refined::{
     reference_pluck_on_grid, refined_reference_pluck, yardstick_grid, ModalVariant,
     YARDSTICK_REFINEMENT,
 };
+use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
+use javari_core::tanpura::VoiceSettings;
 
 const SAMPLE_RATE_HZ: f64 = 44_100.0;
 const TIERS: [Quality; 4] = [
@@ -57,6 +59,22 @@ fn residual_modes(args: &[String]) -> usize {
                 .and_then(|n| n.parse().ok())
                 .expect("--residual-modes takes a count")
         })
+}
+
+/// A grid note of the live tier's string as `variant` changes it (`refined::modal_variant_pluck`).
+fn live_variant_render(
+    settings: &VoiceSettings,
+    variant: &ModalVariant,
+    pluck: &Pluck,
+) -> Vec<f64> {
+    modal_variant_pluck(
+        settings,
+        variant,
+        pluck,
+        javari_core::analysis::playing_range::NOTE_SECONDS,
+        SAMPLE_RATE_HZ,
+    )
+    .expect("the live tier is modal")
 }
 
 /// `measure` of every point, on all cores, in the points' order.
@@ -120,14 +138,7 @@ fn rate_grid() {
                 oversample,
                 ..ModalVariant::default()
             };
-            let output = modal_variant_pluck(
-                &settings,
-                &variant,
-                &pluck,
-                javari_core::analysis::playing_range::NOTE_SECONDS,
-                SAMPLE_RATE_HZ,
-            )
-            .expect("the live tier is modal");
+            let output = live_variant_render(&settings, &variant, &pluck);
             (
                 compare(&output, &refined, SAMPLE_RATE_HZ, nominal),
                 compare(&output, &reference, SAMPLE_RATE_HZ, nominal),
@@ -342,14 +353,7 @@ fn live_variants(args: &[String]) {
         point.label()
     );
     for (name, variant) in variants {
-        let output = modal_variant_pluck(
-            &settings,
-            &variant,
-            &pluck,
-            javari_core::analysis::playing_range::NOTE_SECONDS,
-            SAMPLE_RATE_HZ,
-        )
-        .expect("the live tier is modal");
+        let output = live_variant_render(&settings, &variant, &pluck);
         let row = |against: &[f64]| {
             let d = compare(&output, against, SAMPLE_RATE_HZ, point.nominal_hz());
             format!(
