@@ -47,6 +47,11 @@ pub struct TierOverGrid {
     pub points: Vec<(GridPoint, ListeningDifference)>,
 }
 
+/// The crest keys: where the string at rest lies at the edge of the bridge's crest, and where
+/// the reference's grid is the least resolved scheme (README, *At the crest keys the reference
+/// is the least resolved scheme*; `core/tests/tanpura_crest_threshold.rs`).
+pub const CREST_KEYS: std::ops::RangeInclusive<u8> = 48..=54;
+
 /// Worst case and median of one measure over the grid, and where the worst lies.
 #[derive(Debug, Clone)]
 pub struct Spread {
@@ -68,6 +73,19 @@ impl TierOverGrid {
             worst,
             median: values[values.len() / 2].0,
             worst_at,
+        }
+    }
+
+    /// The same comparison without the plucks of `keys`.
+    pub fn without_keys(&self, keys: &std::ops::RangeInclusive<u8>) -> TierOverGrid {
+        TierOverGrid {
+            tier: self.tier,
+            points: self
+                .points
+                .iter()
+                .filter(|(point, _)| !keys.contains(&point.key))
+                .cloned()
+                .collect(),
         }
     }
 
@@ -419,6 +437,53 @@ pub fn to_markdown(results: &[TierOverGrid]) -> String {
     }
     text.pop();
     text.push_str(".\n");
+    text.push_str(&away_from_the_crest_markdown(results));
+    text
+}
+
+/// Each tier's worst plucks over the grid without [`CREST_KEYS`], where the reference is the
+/// least resolved scheme: how far the tiers' misses are their own. Empty if no pluck is left.
+fn away_from_the_crest_markdown(results: &[TierOverGrid]) -> String {
+    let mut text = String::new();
+    for tier in results
+        .iter()
+        .filter(|t| t.tier != Quality::Reference.name())
+    {
+        let away = tier.without_keys(&CREST_KEYS);
+        if away.points.is_empty() {
+            continue;
+        }
+        if text.is_empty() {
+            let _ = write!(
+                text,
+                "\nAway from the crest keys ({}–{}, where the reference's grid is the least \
+                 resolved scheme), worst over the other {} plucks:",
+                CREST_KEYS.start(),
+                CREST_KEYS.end(),
+                away.points.len()
+            );
+        }
+        let (pitch, bands, centroid) = (
+            away.sustained_cents(),
+            away.band_level_db(),
+            away.centroid_error(),
+        );
+        let _ = write!(
+            text,
+            " {} pitch {:.2} cents ({}), band levels {:.1} dB ({}), centroid {:.1} % ({});",
+            tier.tier,
+            pitch.worst,
+            pitch.worst_at.label(),
+            bands.worst,
+            bands.worst_at.label(),
+            100.0 * centroid.worst,
+            centroid.worst_at.label()
+        );
+    }
+    if !text.is_empty() {
+        text.pop();
+        text.push_str(".\n");
+    }
     text
 }
 
@@ -556,6 +621,34 @@ mod tests {
             table.contains("draft 9.7 / 9.7 dB (key 60, velocity 127, pluck at 0.20 m)."),
             "{table}"
         );
+    }
+
+    #[test]
+    fn the_worst_plucks_away_from_the_crest_keys_leave_the_crest_keys_out() {
+        let live = TierOverGrid {
+            tier: Quality::Live.name(),
+            points: vec![
+                (point(51, 1), difference(-11.9, 16.2)),
+                (point(57, 1), difference(-1.87, 3.0)),
+                (point(60, 40), difference(0.3, 12.0)),
+            ],
+        };
+        let table = to_markdown(std::slice::from_ref(&live));
+        assert!(
+            table.contains(
+                "Away from the crest keys (48–54, where the reference's grid is the least resolved \
+                 scheme), worst over the other 2 plucks: live pitch 1.87 cents (key 57, velocity \
+                 1, pluck at 0.20 m), band levels 12.0 dB (key 60, velocity 40, pluck at 0.20 m), \
+                 centroid 10.0 % (key"
+            ),
+            "{table}"
+        );
+        // A grid of crest keys alone leaves nothing to say.
+        let crest_only = TierOverGrid {
+            tier: Quality::Live.name(),
+            points: vec![(point(51, 1), difference(-11.9, 16.2))],
+        };
+        assert!(!to_markdown(&[crest_only]).contains("Away from the crest keys"));
     }
 
     #[test]
