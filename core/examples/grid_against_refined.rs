@@ -29,6 +29,7 @@ use javari_core::analysis::refined::{
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::VoiceSettings;
+use rayon::prelude::*;
 
 const SAMPLE_RATE_HZ: f64 = 44_100.0;
 const TIERS: [Quality; 4] = [
@@ -77,32 +78,12 @@ fn live_variant_render(
     .expect("the live tier is modal")
 }
 
-/// `measure` of every point, on all cores, in the points' order.
-fn measure_all<T: Send>(points: &[GridPoint], measure: impl Fn(&GridPoint) -> T + Sync) -> Vec<T> {
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut results: Vec<(usize, T)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut mine = Vec::new();
-                    loop {
-                        let index = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(point) = points.get(index) else {
-                            break mine;
-                        };
-                        mine.push((index, measure(point)));
-                    }
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|handle| handle.join().expect("a worker panicked"))
-            .collect()
-    });
-    results.sort_by_key(|(index, _)| *index);
-    results.into_iter().map(|(_, result)| result).collect()
+/// `measure` of every point, on all cores (rayon), in the points' order.
+fn measure_all<T: Send>(
+    points: &[GridPoint],
+    measure: impl Fn(&GridPoint) -> T + Sync + Send,
+) -> Vec<T> {
+    points.par_iter().map(measure).collect()
 }
 
 /// Worst and median of each measure over the plucks: (pitch, cents), (band levels, dB),
@@ -201,37 +182,29 @@ fn yardstick_check() {
         2 * intervals,
         2 * oversample
     );
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = points
-            .iter()
-            .map(|point| {
-                scope.spawn(move || {
-                    let (settings, pluck) = grid_pluck(Quality::Reference, point);
-                    let finer = refined_reference_pluck(
-                        &settings,
-                        2 * YARDSTICK_REFINEMENT,
-                        &pluck,
-                        javari_core::analysis::playing_range::NOTE_SECONDS,
-                        SAMPLE_RATE_HZ,
-                    )
-                    .expect("the reference tier is an FD tier")
-                    .output;
-                    let yardstick = grid_render_refined(point, SAMPLE_RATE_HZ);
-                    compare(&yardstick, &finer, SAMPLE_RATE_HZ, point.nominal_hz())
-                })
-            })
-            .collect();
-        for (point, handle) in points.iter().zip(handles) {
-            let d = handle.join().expect("a worker panicked");
-            println!(
-                "{:<36} {:6.2} {:5.1} {:6.1}",
-                point.label(),
-                d.sustained_cents,
-                d.band_level_db,
-                100.0 * d.centroid_error
-            );
-        }
+    let differences = measure_all(&points, |point| {
+        let (settings, pluck) = grid_pluck(Quality::Reference, point);
+        let finer = refined_reference_pluck(
+            &settings,
+            2 * YARDSTICK_REFINEMENT,
+            &pluck,
+            javari_core::analysis::playing_range::NOTE_SECONDS,
+            SAMPLE_RATE_HZ,
+        )
+        .expect("the reference tier is an FD tier")
+        .output;
+        let yardstick = grid_render_refined(point, SAMPLE_RATE_HZ);
+        compare(&yardstick, &finer, SAMPLE_RATE_HZ, point.nominal_hz())
     });
+    for (point, d) in points.iter().zip(differences) {
+        println!(
+            "{:<36} {:6.2} {:5.1} {:6.1}",
+            point.label(),
+            d.sustained_cents,
+            d.band_level_db,
+            100.0 * d.centroid_error
+        );
+    }
 }
 
 /// The pluck named by the three arguments after `flag` (KEY VELOCITY POSITION_M), and where
