@@ -15,8 +15,7 @@ use javari_core::tanpura::as_played::{
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use rayon::prelude::*;
 
 const SAMPLE_RATE: f64 = 44_100.0;
 const VELOCITIES: [u8; 6] = [1, 40, 60, 80, 110, 127];
@@ -70,47 +69,41 @@ fn main() {
     if keys.is_empty() {
         keys = (36..=64).collect();
     }
-    let rows = Mutex::new(Vec::new());
-    let next = AtomicUsize::new(0);
-    std::thread::scope(|scope| {
-        for _ in 0..std::thread::available_parallelism().map_or(2, |n| n.get()) {
-            scope.spawn(|| {
-                while let Some(&key) = keys.get(next.fetch_add(1, Ordering::Relaxed)) {
-                    let settings = VoiceSettings {
-                        fundamental_hz: note_to_hz(key),
-                        quality,
-                        thread_position_m,
-                        ..VoiceSettings::default()
-                    };
-                    // As the engine measures it: the studio with the reference's jawari.
-                    let as_played = Calibration::measure(
-                        &CalibrationRequest {
-                            settings,
-                            pluck: *pluck,
-                            velocities: NOTE_VELOCITIES,
-                        },
-                        SAMPLE_RATE,
-                    );
-                    let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
-                    let linearised = row(&mut voice, pluck, key, 0.0);
-                    voice.set_settings(&VoiceSettings {
-                        thread_position_m: settings.thread_position_m + as_played.thread_offset_m,
-                        ..settings
-                    });
-                    let played = row(&mut voice, pluck, key, as_played.offset_cents);
-                    rows.lock().expect("a row thread panicked").push((
-                        key,
-                        as_played.offset_cents,
-                        as_played.thread_offset_m,
-                        linearised,
-                        played,
-                    ));
-                }
+    // One job per key on all cores (rayon); the rows come back in the keys' order.
+    let rows: Vec<_> = keys
+        .par_iter()
+        .map(|&key| {
+            let settings = VoiceSettings {
+                fundamental_hz: note_to_hz(key),
+                quality,
+                thread_position_m,
+                ..VoiceSettings::default()
+            };
+            // As the engine measures it: the studio with the reference's jawari.
+            let as_played = Calibration::measure(
+                &CalibrationRequest {
+                    settings,
+                    pluck: *pluck,
+                    velocities: NOTE_VELOCITIES,
+                },
+                SAMPLE_RATE,
+            );
+            let mut voice = TanpuraVoice::new(&settings, SAMPLE_RATE);
+            let linearised = row(&mut voice, pluck, key, 0.0);
+            voice.set_settings(&VoiceSettings {
+                thread_position_m: settings.thread_position_m + as_played.thread_offset_m,
+                ..settings
             });
-        }
-    });
-    let mut rows = rows.into_inner().expect("a row thread panicked");
-    rows.sort_by_key(|row| row.0);
+            let played = row(&mut voice, pluck, key, as_played.offset_cents);
+            (
+                key,
+                as_played.offset_cents,
+                as_played.thread_offset_m,
+                linearised,
+                played,
+            )
+        })
+        .collect();
     println!(
         "{} tier, thread at {:.1} mm, plucked at {:.2} m, cents from the key's pitch at MIDI \
          velocities {VELOCITIES:?}",

@@ -1,6 +1,7 @@
 //! Where the string starts to rest on the bridge's crest, and how a pluck there sounds, on the
 //! reference tier's grid and on finer ones: `cargo run --release -p javari-core --example
-//! crest_threshold` (about a minute on two cores).
+//! crest_threshold [KEY…] [pluck=M]` (keys 49–54 and the bench's default pluck at 0.35 m unless
+//! given; about a minute on two cores for six keys).
 //!
 //! The playing-range grid's worst plucks (README, issue 15) all lie at keys 48–54, where the
 //! reference tier's string at rest just touches the bridge's crest, 7 mm past the thread. Whether
@@ -33,13 +34,15 @@
 use javari_core::analysis::cents;
 use javari_core::analysis::listening::{compare, sustained_pitch_hz};
 use javari_core::analysis::playing_range::NOTE_SECONDS;
+use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::ModalString;
 #[path = "support/schemes.rs"]
 mod schemes;
 use schemes::{on_all_cores, Scheme, OUTPUT_RATE_HZ};
 
-const KEYS: [u8; 6] = [49, 50, 51, 52, 53, 54];
+/// The keys asked by default: those whose string starts to rest on the crest (section 9).
+const DEFAULT_KEYS: [u8; 6] = [49, 50, 51, 52, 53, 54];
 const VELOCITIES: [u8; 4] = [1, 40, 80, 127];
 /// The index of N = 800 at 16× among the plucked schemes: the yardstick of part 3.
 const FINE: usize = 2;
@@ -75,6 +78,19 @@ fn key_hz(key: u8) -> f64 {
 }
 
 fn main() {
+    let arguments: Vec<String> = std::env::args().skip(1).collect();
+    let mut keys: Vec<u8> = arguments
+        .iter()
+        .filter_map(|key| key.parse().ok())
+        .collect();
+    if keys.is_empty() {
+        keys = DEFAULT_KEYS.to_vec();
+    }
+    let keys = &keys[..];
+    let pluck_position_m = arguments
+        .iter()
+        .find_map(|argument| argument.strip_prefix("pluck=")?.parse::<f64>().ok())
+        .unwrap_or(Pluck::default().position_m);
     let seed_tension = FdStringConfig::REFERENCE.string.tension_n;
     let seed_hz = FdString::new(FdStringConfig::REFERENCE).linearised_fundamental_hz();
     let tension_of = |key: u8| seed_tension * (key_hz(key) / seed_hz).powi(2);
@@ -94,13 +110,13 @@ fn main() {
     ];
     println!("\n1. At rest: the deepest bridge gap, µm (positive: into the crest)");
     print!("| scheme |");
-    for key in KEYS {
+    for &key in keys {
         print!(" key {key} |");
     }
     println!();
     for scheme in static_schemes {
         print!("| {} |", scheme.name());
-        for key in KEYS {
+        for &key in keys {
             print!(" {:+.2} |", deepest_rest_gap_um(scheme, tension_of(key)));
         }
         println!();
@@ -117,29 +133,30 @@ fn main() {
     // Every (scheme, key) on the machine's cores, the slowest first; each renders its four
     // velocities.
     let mut jobs: Vec<(usize, usize)> = (0..dynamic_schemes.len())
-        .flat_map(|s| (0..KEYS.len()).map(move |k| (s, k)))
+        .flat_map(|s| (0..keys.len()).map(move |k| (s, k)))
         .collect();
     jobs.sort_by_key(|&(s, _)| usize::from(s != FINE));
     let forces = on_all_cores(&jobs, |&(s, k)| {
-        let (scheme, key) = (dynamic_schemes[s], KEYS[k]);
+        let (scheme, key) = (dynamic_schemes[s], keys[k]);
         VELOCITIES
             .iter()
             .map(|&velocity| {
                 scheme.pluck_nut_force(
                     Some(tension_of(key)),
                     f64::from(velocity) / 127.0,
+                    pluck_position_m,
                     NOTE_SECONDS,
                 )
             })
             .collect::<Vec<Vec<f64>>>()
     });
-    let mut renders = vec![vec![Vec::new(); KEYS.len()]; dynamic_schemes.len()];
+    let mut renders = vec![vec![Vec::new(); keys.len()]; dynamic_schemes.len()];
     for (&(s, k), forces) in jobs.iter().zip(forces) {
         renders[s][k] = forces;
     }
     let header = || {
         print!("| scheme |");
-        for key in KEYS {
+        for &key in keys {
             print!(" key {key} |");
         }
         println!();
@@ -152,7 +169,7 @@ fn main() {
     header();
     for (scheme, row) in dynamic_schemes.iter().zip(&renders) {
         print!("| {} |", scheme.name());
-        for (&key, forces) in KEYS.iter().zip(row) {
+        for (&key, forces) in keys.iter().zip(row) {
             let pitch = |force: &[f64]| sustained_pitch_hz(force, OUTPUT_RATE_HZ, key_hz(key));
             let soft = pitch(&forces[0]);
             let listed: Vec<String> = forces[1..]
@@ -175,7 +192,7 @@ fn main() {
         for (k, forces) in row.iter().enumerate() {
             let (mut pitch, mut bands, mut centroid) = (0.0f64, 0.0f64, 0.0f64);
             for (force, fine) in forces.iter().zip(&renders[FINE][k]) {
-                let difference = compare(force, fine, OUTPUT_RATE_HZ, key_hz(KEYS[k]));
+                let difference = compare(force, fine, OUTPUT_RATE_HZ, key_hz(keys[k]));
                 pitch = pitch.max(difference.sustained_cents.abs());
                 bands = bands.max(difference.band_level_db);
                 centroid = centroid.max(100.0 * difference.centroid_error);

@@ -21,6 +21,7 @@ use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz
 use javari_core::analysis::{
     cents, first_partials_hz, peak_frequency_hz, third_octave_distance_db,
 };
+use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
 #[path = "support/schemes.rs"]
@@ -59,7 +60,7 @@ fn main() {
     // The longest render (N = 800) first, so that the two cores finish together.
     let order = [3, 0, 1, 2, 4, 5, 6, 7, 8];
     let in_order = on_all_cores(&order, |&index| {
-        schemes[index].pluck_nut_force(None, 1.0, SECONDS)
+        schemes[index].pluck_nut_force(None, 1.0, Pluck::default().position_m, SECONDS)
     });
     let mut renders = vec![Vec::new(); schemes.len()];
     for (&index, output) in order.iter().zip(in_order) {

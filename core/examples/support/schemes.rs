@@ -75,11 +75,19 @@ impl Scheme {
     }
 
     /// The nut force (the seed's signal) at 44.1 kHz for `seconds`, the string at `tension_n`
-    /// (the seed's with `None`) plucked as the bench plucks at `velocity` (0–1); FD through the
+    /// (the seed's with `None`) plucked as the bench plucks at `velocity` (0–1), `position_m`
+    /// from the bead (the bench's default pluck: `Pluck::default().position_m`); FD through the
     /// tiers' Kaiser decimator.
-    pub fn pluck_nut_force(self, tension_n: Option<f64>, velocity: f64, seconds: f64) -> Vec<f64> {
+    pub fn pluck_nut_force(
+        self,
+        tension_n: Option<f64>,
+        velocity: f64,
+        position_m: f64,
+        seconds: f64,
+    ) -> Vec<f64> {
         let pluck = Pluck {
             amplitude_m: Pluck::default().amplitude_m * velocity,
+            position_m,
             ..Pluck::default()
         };
         let samples = (seconds * OUTPUT_RATE_HZ).round() as usize;
@@ -111,28 +119,17 @@ impl Scheme {
     }
 }
 
-/// `work` on every job, on all of the machine's cores, the jobs started in the order given (put
-/// the longest first, so that the cores finish together); the results in the jobs' order.
+/// `work` on every job, on all of the machine's cores (rayon), the jobs started in the order
+/// given (`par_bridge` hands them out as the iterator yields them: put the longest first, so
+/// that the cores finish together); the results in the jobs' order.
 pub fn on_all_cores<J: Sync, R: Send>(jobs: &[J], work: impl Fn(&J) -> R + Sync) -> Vec<R> {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    use std::sync::Mutex;
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<R>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| loop {
-                let index = next.fetch_add(1, Ordering::Relaxed);
-                let Some(job) = jobs.get(index) else { break };
-                let result = work(job);
-                results.lock().unwrap()[index] = Some(result);
-            });
-        }
-    });
-    results
-        .into_inner()
-        .unwrap()
-        .into_iter()
-        .map(|result| result.expect("every job ran"))
-        .collect()
+    use rayon::prelude::*;
+    let mut results: Vec<(usize, R)> = jobs
+        .iter()
+        .enumerate()
+        .par_bridge()
+        .map(|(index, job)| (index, work(job)))
+        .collect();
+    results.sort_by_key(|&(index, _)| index);
+    results.into_iter().map(|(_, result)| result).collect()
 }
