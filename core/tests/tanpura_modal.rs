@@ -462,7 +462,7 @@ fn the_thread_lattice_keeps_newton_near_one_update_per_step_at_every_key() {
                 spacing_m * 1e3,
                 string.thread_lattice_offset_m() * 1e3
             );
-            // The lattice each key takes, as README and docs/modal-tanpura.md §3 state it: a
+            // The lattice each key takes, as docs/modal-tanpura.md §3 states it: a
             // coarser one on the top at keys 36 and 58–60 (the configured one there has a point
             // at the contact's edge), the configured one straddling the top at 37–48 and 61–64
             // (no lattice keeps the margin), the configured one at 49–57.

@@ -1,5 +1,5 @@
 //! How far the reference tier's own output lies from a finer grid, on the bench's one-string
-//! measures (`examples/grid_convergence.rs`, README "Quality tiers", `docs/modal-tanpura.md`
+//! measures (`examples/grid_convergence.rs`, `docs/tiers-log.md`, `docs/modal-tanpura.md`
 //! section 9): the seed's grid (N = 200, 4×) against N = 400 at 16× is as far as the issue's
 //! one-string targets for the tiers (7 dB, 15 %), and farther than N = 400 at 8× is from the same
 //! grid at 16× (the measures' floor between two renders that differ only in the time step).

@@ -48,8 +48,8 @@ pub struct TierOverGrid {
 }
 
 /// The crest keys: where the string at rest lies at the edge of the bridge's crest, and where
-/// the reference's grid is the least resolved scheme (README, *At the crest keys the reference
-/// is the least resolved scheme*; `core/tests/tanpura_crest_threshold.rs`).
+/// the reference's grid is the least resolved scheme (README, *Where the targets are missed*;
+/// `docs/modal-tanpura.md` §9; `core/tests/tanpura_crest_threshold.rs`).
 pub const CREST_KEYS: std::ops::RangeInclusive<u8> = 48..=54;
 
 /// Worst case and median of one measure over the grid, and where the worst lies.

@@ -17,7 +17,7 @@
 //!   Δx_c = 0.15 mm) with a tolerance at round-off; Studio runs at 3 × 44.1 kHz and keeps the
 //!   seed's grids. At 2× its hard plucks' band levels lay up to 5.8 dB from the reference's over
 //!   the playing range; at 3× 4.9 dB, within the 5 dB the tier is held to, for 1.33–1.41 times
-//!   the cost (README, stop 37). Studio's EI is raised so that its inharmonicity matches the
+//!   the cost (`docs/tiers-log.md`, stop 37). Studio's EI is raised so that its inharmonicity matches the
 //!   reference's (`voice.rs`, `dispersion_compensated_stiffness`), for the vibration only: its
 //!   string rests where the reference's rests (the FD rest preload, `fd/mod.rs`).
 //!

@@ -334,7 +334,7 @@ fn dispersion_per_n_squared(
 /// ([`FdStringConfig::rest_bending_stiffness_n_m2`]). Raised everywhere, it made the studio
 /// string's static shape near the thread differ from the reference's by micrometres and
 /// decided differently which keys rest on the crest (its worst sustained pitch over the
-/// playing range, 14.7 cents at key 54, was that; README, stop 34).
+/// playing range, 14.7 cents at key 54, was that; `docs/tiers-log.md`, stop 34).
 fn dispersion_compensated_stiffness(
     quality: Quality,
     string: &StringParameters,
