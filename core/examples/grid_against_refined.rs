@@ -10,14 +10,16 @@
 //! shorter time step or other bridge points; `-- --rate-grid` the live tier's string with and
 //! without two residual modes, at the output rate and at four times it, over the whole grid
 //! against the refined string and against the reference (both tuned by linearisation; about
-//! five minutes on two cores). `cargo xtask bench` measures the same without the residual
+//! five minutes on two cores); `-- --grid-modes` the same with every mode of the reference's FD
+//! grid instead of the continuous string's (§10). `cargo xtask bench` measures the same without the residual
 //! modes, and caches the refined renders.
 //!
 //! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
 //! tier tuned by linearising about its own rest state (no calibration as played), so that the
 //! schemes are compared at equal physical parameters; the refined string is tuned and plucked
 //! the same way. The four measures are the bench's (`analysis::listening::compare`). The figures
-//! are quoted in `docs/modal-tanpura.md`, section 9 ("Stop 35"; `--rate-grid`: "Stop 40").
+//! are quoted in `docs/modal-tanpura.md`, section 9 ("Stop 35"; `--rate-grid`: "Stop 40";
+//! `--grid-modes`: section 10).
 
 use javari_core::analysis::listening::{compare, ListeningDifference};
 use javari_core::analysis::playing_range::{full_grid, GridPoint};
@@ -106,52 +108,97 @@ fn summary(differences: &[&ListeningDifference]) -> [(f64, f64); 3] {
 /// over the whole grid, against N = 800 at 16× and against the reference, all tuned by
 /// linearisation (`docs/modal-tanpura.md`, "Stop 40").
 fn rate_grid() {
-    const VARIANTS: [(usize, usize); 4] = [(0, 1), (0, 4), (2, 1), (2, 4)];
+    let variants = [(0, 1), (0, 4), (2, 1), (2, 4)].map(|(residual_modes, oversample)| {
+        (
+            format!("{residual_modes} residual modes at {oversample}x"),
+            ModalVariant {
+                residual_modes,
+                oversample,
+                ..ModalVariant::default()
+            },
+        )
+    });
+    variants_over_grid(&variants);
+}
+
+/// `--grid-modes`: the live tier's string with the continuous string's modes (as the tier runs)
+/// and with every mode of the reference's FD grid, on the tier's points and on points as fine as
+/// the reference's barrier grid (`docs/modal-tanpura.md` §10).
+fn grid_modes_grid() {
+    let fine = ModalVariant {
+        grid_modes: true,
+        bridge_point_spacing_m: Some(0.18e-3),
+        thread_point_spacing_m: Some(0.15e-3),
+        ..ModalVariant::default()
+    };
+    let variants = [
+        (
+            "continuous modes (the tier)".to_owned(),
+            ModalVariant::default(),
+        ),
+        (
+            "grid modes, the tier's points".to_owned(),
+            ModalVariant {
+                grid_modes: true,
+                ..ModalVariant::default()
+            },
+        ),
+        ("grid modes, points every 0.18 / 0.15 mm".to_owned(), fine),
+    ];
+    variants_over_grid(&variants);
+}
+
+/// The keys where the reference's grid first rests the string on the crest (the bench's
+/// `CREST_KEYS`), left out of the second summary.
+const CREST_KEYS: std::ops::RangeInclusive<u8> = 48..=54;
+
+/// Each variant of the live tier's string over the whole grid, against N = 800 at 16× and
+/// against the reference, all tuned by linearisation: worst / median of each measure, over every
+/// pluck and over the plucks away from [`CREST_KEYS`].
+fn variants_over_grid(variants: &[(String, ModalVariant)]) {
     let points = full_grid();
     let results = measure_all(&points, |point| {
         let refined = grid_render_refined(point, SAMPLE_RATE_HZ);
         let reference = grid_render_linearised(Quality::Reference, point, SAMPLE_RATE_HZ, 0);
         let (settings, pluck) = grid_pluck(Quality::Live, point);
         let nominal = point.nominal_hz();
-        VARIANTS.map(|(residual_modes, oversample)| {
-            let variant = ModalVariant {
-                residual_modes,
-                oversample,
-                ..ModalVariant::default()
-            };
-            let output = live_variant_render(&settings, &variant, &pluck);
-            (
-                compare(&output, &refined, SAMPLE_RATE_HZ, nominal),
-                compare(&output, &reference, SAMPLE_RATE_HZ, nominal),
-            )
-        })
+        variants
+            .iter()
+            .map(|(_, variant)| {
+                let output = live_variant_render(&settings, variant, &pluck);
+                [
+                    compare(&output, &refined, SAMPLE_RATE_HZ, nominal),
+                    compare(&output, &reference, SAMPLE_RATE_HZ, nominal),
+                ]
+            })
+            .collect::<Vec<_>>()
     });
     println!(
         "The live tier's string over {} plucks, worst / median (pitch cents, band levels dB, \
          centroid %):",
         points.len()
     );
-    for (column, (residual_modes, oversample)) in VARIANTS.iter().enumerate() {
-        let against = |which: usize| {
-            let differences: Vec<&ListeningDifference> = results
+    for (column, (name, _)) in variants.iter().enumerate() {
+        let against = |which: usize, away_from_crest: bool| {
+            let differences: Vec<&ListeningDifference> = points
                 .iter()
-                .map(|row| {
-                    if which == 0 {
-                        &row[column].0
-                    } else {
-                        &row[column].1
-                    }
-                })
+                .zip(&results)
+                .filter(|(point, _)| !away_from_crest || !CREST_KEYS.contains(&point.key))
+                .map(|(_, row)| &row[column][which])
                 .collect();
             summary(&differences)
                 .map(|(worst, median)| format!("{worst:5.2} / {median:4.2}"))
                 .join(", ")
         };
         println!(
-            "{residual_modes} residual modes at {oversample}x | against N = 800: {} | against \
-             the reference: {}",
-            against(0),
-            against(1)
+            "{name} | against N = 800: {} | against the reference: {}",
+            against(0, false),
+            against(1, false)
+        );
+        println!(
+            "{name}, away from keys 48-54 | against N = 800: {} | against the reference: {}",
+            against(0, true),
+            against(1, true)
         );
     }
 }
@@ -352,6 +399,10 @@ fn main() {
     }
     if args.iter().any(|arg| arg == "--live-variants") {
         live_variants(&args);
+        return;
+    }
+    if args.iter().any(|arg| arg == "--grid-modes") {
+        grid_modes_grid();
         return;
     }
     if args.iter().any(|arg| arg == "--rate-grid") {

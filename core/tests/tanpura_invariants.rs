@@ -7,6 +7,7 @@
 use javari_core::newton::NewtonSettings;
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::fd::{FdString, FdStringConfig, SolverKind};
+use javari_core::tanpura::modal::{GridModes, ModalString, ModalStringConfig};
 use std::f64::consts::PI;
 
 const SAMPLE_RATE: f64 = 176_400.0;
@@ -451,4 +452,59 @@ fn the_studio_tier_rests_where_the_reference_rests() {
             "key {key}"
         );
     }
+}
+
+/// The modal string on the reference's grid (`ModalStringConfig::grid_modes`,
+/// `docs/modal-tanpura.md` §10), its modes advanced exactly at 44.1 kHz, rings at the partials
+/// of the FD string on that grid at 4 × 44.1 kHz (which the test above holds to the scheme's own
+/// dispersion): the first ten agree to 1e-6, where the continuous string's modes lie up to
+/// 2.7 cents (1.6e-3) above them at the tenth.
+#[test]
+fn grid_modes_ring_at_the_fd_schemes_own_partials() {
+    let output_rate = SAMPLE_RATE / 4.0;
+    let mut fd = plucked(linear_string(200, SAMPLE_RATE, true));
+    let fd_partials: Vec<f64> = modal_histories(&mut fd, 0.25, SAMPLE_RATE)
+        .iter()
+        .map(|history| zero_crossing_frequency(history, SAMPLE_RATE))
+        .collect();
+    let modal_partials = |grid_modes: Option<GridModes>| -> Vec<f64> {
+        let mut config = ModalStringConfig::REFERENCE.lossless();
+        config.time_step_s = 1.0 / output_rate;
+        config.bridge.stiffness_n_m2 = 0.0;
+        config.thread = None;
+        config.grid_modes = grid_modes;
+        let mut string = ModalString::<f64>::new(config);
+        string.pluck(&Pluck::default());
+        let mut histories: Vec<Vec<f64>> = vec![Vec::new(); 10];
+        for _ in 0..(0.25 * output_rate) as usize {
+            string.step();
+            for (history, &r) in histories.iter_mut().zip(string.modal_state().0) {
+                history.push(r);
+            }
+        }
+        histories
+            .iter()
+            .map(|history| zero_crossing_frequency(history, output_rate))
+            .collect()
+    };
+    let grid = modal_partials(Some(GridModes {
+        intervals: 200,
+        time_step_s: 1.0 / SAMPLE_RATE,
+    }));
+    let continuous = modal_partials(None);
+    for n in 0..10 {
+        let grid_error = (grid[n] - fd_partials[n]).abs() / fd_partials[n];
+        assert!(
+            grid_error <= 1e-6,
+            "partial {}: grid modes {} Hz against the FD's {} Hz",
+            n + 1,
+            grid[n],
+            fd_partials[n]
+        );
+    }
+    let continuous_error = (continuous[9] - fd_partials[9]).abs() / fd_partials[9];
+    assert!(
+        continuous_error > 1e-4,
+        "the continuous modes' tenth partial lies only {continuous_error:e} from the FD's"
+    );
 }

@@ -31,7 +31,7 @@ use crate::analysis::playing_range::{calibration_request, GridPoint, NOTE_SECOND
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::fd::decimator::render_decimated;
 use crate::tanpura::fd::FdString;
-use crate::tanpura::modal::ModalString;
+use crate::tanpura::modal::{GridModes, ModalString};
 use crate::tanpura::quality::Quality;
 use crate::tanpura::tier_string::weighted_pickup_n;
 use crate::tanpura::voice::tune_tension;
@@ -140,6 +140,23 @@ pub struct ModalVariant {
     pub oversample: usize,
     /// The bridge's points every this many metres instead of the tier's spacing.
     pub bridge_point_spacing_m: Option<f64>,
+    /// The thread's points every this many metres instead of the tier's spacing.
+    pub thread_point_spacing_m: Option<f64>,
+    /// Every mode of the reference tier's FD grid instead of the continuous string's
+    /// ([`reference_grid_modes`], `docs/modal-tanpura.md` §10).
+    pub grid_modes: bool,
+}
+
+/// The reference tier's grid as modes for a modal string at `output_sample_rate_hz`: its
+/// intervals, and the time step of its oversampled trapezoidal rule.
+pub fn reference_grid_modes(output_sample_rate_hz: f64) -> GridModes {
+    let tier = Quality::Reference
+        .fd_tier()
+        .expect("the reference tier is an FD tier");
+    GridModes {
+        intervals: tier.intervals,
+        time_step_s: 1.0 / (output_sample_rate_hz * tier.oversample as f64),
+    }
 }
 
 impl Default for ModalVariant {
@@ -148,6 +165,8 @@ impl Default for ModalVariant {
             residual_modes: 0,
             oversample: 1,
             bridge_point_spacing_m: None,
+            thread_point_spacing_m: None,
+            grid_modes: false,
         }
     }
 }
@@ -166,8 +185,14 @@ pub fn modal_variant_pluck(
     let mut config =
         settings.modal_config_at(settings.quality, sample_rate_hz * oversample as f64)?;
     config.residual_modes = variant.residual_modes;
+    if variant.grid_modes {
+        config.grid_modes = Some(reference_grid_modes(sample_rate_hz));
+    }
     if let Some(spacing_m) = variant.bridge_point_spacing_m {
         config.bridge_point_spacing_m = spacing_m;
+    }
+    if let Some(spacing_m) = variant.thread_point_spacing_m {
+        config.thread_point_spacing_m = spacing_m;
     }
     let mut string = ModalString::<f32>::new(config);
     tune_tension(

@@ -9,7 +9,10 @@
 //!   frequencies and decay rates σ = γ/2 + ηω²/2 at any sample rate, no oversampling, no
 //!   dispersion, no decimator. Modes below min(20 kHz, 0.45 f_s) are kept. Optionally
 //!   ([`ModalStringConfig::residual_modes`], section 8) a few residual modes follow them: the
-//!   truncated modes' static compliance on the contact points, as resonators at 0.475 f_s.
+//!   truncated modes' static compliance on the contact points, as resonators at 0.475 f_s. Or
+//!   ([`ModalStringConfig::grid_modes`], section 10) every mode of the seed's FD grid, at the FD
+//!   scheme's own frequencies, seen at the points through its cubic interpolation: the FD string
+//!   in space, advanced exactly in time.
 //! - `points.rs`: the bridge and thread as a few contact points, coupled to the modes through the
 //!   mode shapes there, with the seed's mid-point Hunt–Crossley force (eq. 4, `contact.rs`).
 //! - `solve.rs`: Newton's method on the points that touch (section 4), the static problems of
@@ -44,6 +47,7 @@ use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
 use crate::tanpura::string::StringParameters;
 use crate::tanpura::tier_string::weighted_pickup_n;
 use lanes::{padded_lanes, AdvanceAndPrepare, Dots, Kernels, LeadingDots, Real, LANE_PADDING};
+pub use modes::GridModes;
 use modes::{ModeSet, AUDIBLE_LIMIT_HZ, MODE_CAPACITY};
 use points::{grid_points, ContactPoints};
 use pulp::{Simd, WithSimd};
@@ -135,9 +139,25 @@ pub struct ModalStringConfig {
     /// Skip the free steps of the far points that provably cannot touch before the next
     /// excitation (section 7); the output is the same bit for bit either way.
     pub sleep_far_points: bool,
+    /// Take every mode of this FD grid instead of the continuous string's modes below
+    /// `highest_mode_hz` (section 10): the string is then the seed's FD string in space, advanced
+    /// exactly in time. Excludes the static flexibility and residual modes (both are the
+    /// continuous string's truncated part; the grid's modes are all kept). `None`: the tiers'.
+    pub grid_modes: Option<GridModes>,
 }
 
 impl ModalStringConfig {
+    /// The configuration the string runs: grid modes only when valid ([`GridModes::is_valid`]),
+    /// and with them neither the static flexibility nor residual modes.
+    fn sanitised(mut self) -> Self {
+        self.grid_modes = self.grid_modes.filter(|grid| grid.is_valid());
+        if self.grid_modes.is_some() {
+            self.static_flexibility = false;
+            self.residual_modes = 0;
+        }
+        self
+    }
+
     /// The seed's string, bridge and thread at 44.1 kHz, modes up to 20 kHz, contact points
     /// every millimetre on the bridge and every half millimetre on the thread.
     pub const REFERENCE: ModalStringConfig = ModalStringConfig {
@@ -157,6 +177,7 @@ impl ModalStringConfig {
         static_flexibility: false,
         residual_modes: 0,
         sleep_far_points: true,
+        grid_modes: None,
     };
 
     /// The same with all losses off (γ = η = r_b = r_c = 0).
@@ -291,6 +312,7 @@ pub struct ModalString<T: Real> {
 impl<T: Real> ModalString<T> {
     /// Builds the string and settles it at rest on bridge and thread. Allocates.
     pub fn new(config: ModalStringConfig) -> Self {
+        let config = config.sanitised();
         let points = config.point_capacity();
         let finger = grid_points(0.0, MAX_FINGER_WIDTH_M, config.finger.spacing_m);
         let mut string = Self {
@@ -337,6 +359,7 @@ impl<T: Real> ModalString<T> {
     /// displacement and velocity) about the new rest state. Returns false, changing nothing,
     /// when the new configuration needs more contact points than the string was built for.
     pub fn set_config(&mut self, config: ModalStringConfig) -> bool {
+        let config = config.sanitised();
         if config.point_capacity() > self.points.capacity()
             || config.time_step_s.is_nan()
             || config.time_step_s <= 0.0
@@ -390,8 +413,12 @@ impl<T: Real> ModalString<T> {
     /// [`ModalString::place_thread_lattice`] takes. Leaves the rest state solved.
     fn apply_config(&mut self, keep_lattice: bool) {
         let config = self.config;
-        self.modes
-            .configure(&config.string, config.time_step_s, config.highest_mode_hz);
+        self.modes.configure(
+            &config.string,
+            config.time_step_s,
+            config.highest_mode_hz,
+            config.grid_modes,
+        );
         self.modes.set_residual_modes(
             config.residual_modes,
             2.0 * PI * RESIDUAL_MODE_RATE_FRACTION / config.time_step_s,
@@ -795,17 +822,7 @@ impl<T: Real> ModalString<T> {
     /// `Σ_k Ψ_k(x) c_k` for modal coefficients `c_k`, with the sines by recurrence (no scratch,
     /// so `&self`).
     fn modal_sum(&self, x_m: f64, coefficient: impl Fn(usize) -> f64) -> f64 {
-        let theta = PI * x_m / self.config.string.length_m;
-        let twice_cos = 2.0 * theta.cos();
-        let (mut previous, mut current) = (0.0, theta.sin());
-        let mut sum = 0.0;
-        for k in 0..self.modes.count() {
-            sum += current * self.modes.inverse_root_stiffness[k] * coefficient(k);
-            let next = twice_cos * current - previous;
-            previous = current;
-            current = next;
-        }
-        sum
+        self.modes.shape_sum(x_m, coefficient)
     }
 
     /// y_s(x), the line between the supports, m.

@@ -13,17 +13,46 @@
 //! low modes carries no cancellation. An overdamped mode (σ ≥ ω) takes its two real poles:
 //! `a = (1 + z₁)(1 + z₂)/2`, `b = (1 − z₁)(1 − z₂)/2`. The discrete energy of mode k is
 //! `r²/2 + (a/2b) p²` and it loses `((1 − e²)/2b) s²` per step (eq. M2).
+//!
+//! With [`GridModes`] (section 10) the modes are instead those of the seed's FD grid of N
+//! intervals: the sampled sines `sin(kπi/N)`, k = 1 … N − 1, all kept, with `β_k²` replaced by
+//! `μ_k = (4/Δx²) sin²(kπ/2N)` in κ_k and ω_k, each frequency lowered by the FD's trapezoidal
+//! rule to `(2/Δt_FD) atan(ω_k Δt_FD/2)` in the recursion, shapes at a point by the FD's cubic
+//! Lagrange interpolation of the nodes, and the nut weight the FD operator's nut force of the
+//! sampled sine (zero above the output band, which the FD tiers' decimator removes).
 
+use crate::tanpura::fd::barrier_grid::lagrange_stencil;
 use crate::tanpura::string::StringParameters;
 use std::f64::consts::PI;
 
 /// Most modes a string keeps. The stiffness bounds the count below 20 kHz at about 121 (a 20 Hz
-/// string at the seed's EI and ρA); the capacity is a multiple of the lane padding.
-pub const MODE_CAPACITY: usize = 128;
+/// string at the seed's EI and ρA); the reference's grid has 199 ([`GridModes`]); the capacity
+/// is a multiple of the lane padding.
+pub const MODE_CAPACITY: usize = 256;
 /// Modes are kept up to this frequency (nothing above is audible) ...
 pub const AUDIBLE_LIMIT_HZ: f64 = 20_000.0;
 /// ... and below this fraction of the sample rate, so that no pole sits at Nyquist.
 pub const NYQUIST_GUARD: f64 = 0.45;
+
+/// The FD grid whose modes a string takes instead of the continuous string's
+/// (`docs/modal-tanpura.md` §10): the seed's grid of `intervals` intervals, whose eigenvectors are
+/// the sampled sines `sin(kπi/N)` (k = 1 … N − 1), and the time step of its trapezoidal rule,
+/// whose frequency warp the modes take so that their partials are the FD scheme's own.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridModes {
+    pub intervals: usize,
+    pub time_step_s: f64,
+}
+
+impl GridModes {
+    /// Whether the grid can be taken: at least four intervals (the cubic interpolation's
+    /// stencil) and at most one more than [`MODE_CAPACITY`], a positive finite time step.
+    pub fn is_valid(self) -> bool {
+        (4..=MODE_CAPACITY + 1).contains(&self.intervals)
+            && self.time_step_s.is_finite()
+            && self.time_step_s > 0.0
+    }
+}
 
 /// Everything about the modes that depends on the string and the time step, in f64.
 #[derive(Debug, Clone)]
@@ -37,11 +66,14 @@ pub struct ModeSet {
     /// T, N, and EI, N m²: the static compliance of all the modes is closed-form in them.
     tension_n: f64,
     bending_stiffness_n_m2: f64,
+    /// The grid whose modes these are, or `None` for the continuous string's sines.
+    grid: Option<GridModes>,
     /// κ_k, N/m.
     pub stiffness: Vec<f64>,
     /// 1/√κ_k.
     pub inverse_root_stiffness: Vec<f64>,
-    /// ω_k, rad/s (undamped).
+    /// ω_k, rad/s (undamped; with grid modes the grid's own, before the time step's warp,
+    /// which only the recursion coefficients take).
     pub angular_frequency: Vec<f64>,
     /// σ_k, 1/s.
     pub decay: Vec<f64>,
@@ -66,6 +98,7 @@ impl ModeSet {
             length_m: 1.0,
             tension_n: 1.0,
             bending_stiffness_n_m2: 0.0,
+            grid: None,
             stiffness: zeros(),
             inverse_root_stiffness: zeros(),
             angular_frequency: zeros(),
@@ -127,32 +160,74 @@ impl ModeSet {
     }
 
     /// Computes the modes of `string` below `highest_mode_hz` (and below 0.45 of the sample rate)
-    /// and their recursion coefficients for the step `time_step_s`. Allocation-free.
-    pub fn configure(&mut self, string: &StringParameters, time_step_s: f64, highest_mode_hz: f64) {
+    /// and their recursion coefficients for the step `time_step_s`; with `grid` (valid), every
+    /// mode of that FD grid instead, whatever its frequency (§10). Allocation-free.
+    pub fn configure(
+        &mut self,
+        string: &StringParameters,
+        time_step_s: f64,
+        highest_mode_hz: f64,
+        grid: Option<GridModes>,
+    ) {
         let length = string.length_m;
         let limit_hz = Self::frequency_limit_hz(1.0 / time_step_s, highest_mode_hz);
         let half_length = 0.5 * length;
         let mass = string.linear_density_kg_m * half_length;
+        let grid = grid.filter(|grid| grid.is_valid());
         self.length_m = length;
         self.tension_n = string.tension_n;
         self.bending_stiffness_n_m2 = string.bending_stiffness_n_m2;
+        self.grid = grid;
         self.count = 0;
         for index in 0..MODE_CAPACITY {
             let number = (index + 1) as f64;
-            let wavenumber = number * PI / length;
-            let k2 = wavenumber * wavenumber;
+            // The operator's eigenvalue per unit tension, μ_k (the continuous string's β_k², the
+            // grid's (4/Δx²) sin²(kπ/2N)), and the nut force per unit q_k.
+            let (k2, nut_force) = match grid {
+                Some(GridModes { intervals, .. }) => {
+                    if index + 1 >= intervals {
+                        break;
+                    }
+                    let spacing = length / intervals as f64;
+                    let half_angle = number * PI / (2.0 * intervals as f64);
+                    let k2 = (2.0 * half_angle.sin() / spacing).powi(2);
+                    // The FD operator's nut force (`fd::operator::StringOperator::nut_force_n`)
+                    // of the sampled sine, whose nodes N − 1 and N − 2 are these.
+                    let node = |i: usize| (number * PI * i as f64 / intervals as f64).sin();
+                    let last = node(intervals - 1);
+                    let curvature = (node(intervals - 2) - 2.0 * last) / (spacing * spacing);
+                    let nut_force = -string.bending_stiffness_n_m2 * curvature / spacing
+                        + string.tension_n * last / spacing;
+                    (k2, nut_force)
+                }
+                None => {
+                    let wavenumber = number * PI / length;
+                    let k2 = wavenumber * wavenumber;
+                    let sign = if index % 2 == 0 { 1.0 } else { -1.0 }; // −(−1)^k, k = index + 1
+                    let nut_force = sign
+                        * (string.tension_n * wavenumber
+                            + string.bending_stiffness_n_m2 * wavenumber * k2);
+                    (k2, nut_force)
+                }
+            };
             let stiffness =
                 half_length * (string.tension_n * k2 + string.bending_stiffness_n_m2 * k2 * k2);
             let omega = (stiffness / mass).sqrt();
             // NaN (a degenerate string) stops the count like a mode above the limit.
             let below_limit = omega / (2.0 * PI) < limit_hz;
-            if !below_limit && index > 0 {
+            if !below_limit && index > 0 && grid.is_none() {
                 break;
             }
             let decay = 0.5 * string.gamma_per_s + 0.5 * string.eta_s * omega * omega;
-            let (a, b, det) = recursion_coefficients(omega, decay, time_step_s);
+            // The grid's trapezoidal rule lowers each frequency to (2/Δt) atan(ωΔt/2).
+            let heard_omega = match grid {
+                Some(GridModes { time_step_s, .. }) => {
+                    2.0 / time_step_s * (0.5 * omega * time_step_s).atan()
+                }
+                None => omega,
+            };
+            let (a, b, det) = recursion_coefficients(heard_omega, decay, time_step_s);
             let root = stiffness.sqrt();
-            let sign = if index % 2 == 0 { 1.0 } else { -1.0 }; // −(−1)^k with k = index + 1
             self.stiffness[index] = stiffness;
             self.inverse_root_stiffness[index] = 1.0 / root;
             self.angular_frequency[index] = omega;
@@ -161,9 +236,14 @@ impl ModeSet {
             self.b[index] = b;
             self.kinetic_factor[index] = a / (2.0 * b);
             self.loss_factor[index] = (1.0 - det) / (2.0 * b);
-            self.nut_weight[index] = sign
-                * (string.tension_n * wavenumber + string.bending_stiffness_n_m2 * wavenumber * k2)
-                / root;
+            // Grid modes above the output band still move the string (the contact, the static
+            // problems) but are not heard at the nut, as the FD tiers' decimator removes them;
+            // sounded, they would alias into the top octave.
+            self.nut_weight[index] = if grid.is_none() || heard_omega / (2.0 * PI) < limit_hz {
+                nut_force / root
+            } else {
+                0.0
+            };
             self.count = index + 1;
         }
         self.kept = self.count;
@@ -182,8 +262,28 @@ impl ModeSet {
 
     /// Writes `Ψ_k(x) = sin(kπx/L)/√κ_k` for every kept mode into `row` (zeros beyond K, the
     /// residual modes included), by the recurrence `sin((k+1)θ) = 2 cos θ sin(kθ) −
-    /// sin((k−1)θ)`. Allocation-free.
+    /// sin((k−1)θ)`; with grid modes, the FD's cubic Lagrange interpolation of the sampled sines
+    /// at x (`fd::barrier_grid::lagrange_stencil`, eq. 17 of the seed), over √κ_k.
+    /// Allocation-free.
     pub fn shape_row(&self, x_m: f64, row: &mut [f64]) {
+        if let Some(GridModes { intervals, .. }) = self.grid {
+            let (first, weights) =
+                lagrange_stencil(x_m * intervals as f64 / self.length_m, intervals);
+            for (index, value) in row.iter_mut().enumerate() {
+                *value = if index < self.kept {
+                    let angle = (index + 1) as f64 * PI / intervals as f64;
+                    let interpolated: f64 = weights
+                        .iter()
+                        .enumerate()
+                        .map(|(j, weight)| weight * (angle * (first + j) as f64).sin())
+                        .sum();
+                    interpolated * self.inverse_root_stiffness[index]
+                } else {
+                    0.0
+                };
+            }
+            return;
+        }
         let theta = PI * x_m / self.length_m;
         let twice_cos = 2.0 * theta.cos();
         let (mut previous, mut current) = (0.0, theta.sin());
@@ -201,6 +301,38 @@ impl ModeSet {
 }
 
 impl ModeSet {
+    /// `Σ_k Ψ_k(x) c_k` over the kept modes for the coefficients `coefficient(k)`, m: the
+    /// displacement at x of the modal state `c` (the sines by their recurrence, grid modes by
+    /// their interpolation, as in [`ModeSet::shape_row`]). Allocation-free.
+    pub fn shape_sum(&self, x_m: f64, coefficient: impl Fn(usize) -> f64) -> f64 {
+        if let Some(GridModes { intervals, .. }) = self.grid {
+            let (first, weights) =
+                lagrange_stencil(x_m * intervals as f64 / self.length_m, intervals);
+            return (0..self.kept)
+                .map(|index| {
+                    let angle = (index + 1) as f64 * PI / intervals as f64;
+                    let interpolated: f64 = weights
+                        .iter()
+                        .enumerate()
+                        .map(|(j, weight)| weight * (angle * (first + j) as f64).sin())
+                        .sum();
+                    interpolated * self.inverse_root_stiffness[index] * coefficient(index)
+                })
+                .sum();
+        }
+        let theta = PI * x_m / self.length_m;
+        let twice_cos = 2.0 * theta.cos();
+        let (mut previous, mut current) = (0.0, theta.sin());
+        let mut sum = 0.0;
+        for index in 0..self.kept {
+            sum += current * self.inverse_root_stiffness[index] * coefficient(index);
+            let next = twice_cos * current - previous;
+            previous = current;
+            current = next;
+        }
+        sum
+    }
+
     /// The static compliance of the whole string (every mode, not only the kept ones) between
     /// two points, m/N: `C(x, ξ) = Σ_k φ_k(x) φ_k(ξ)/κ_k`, the deflection at x under a unit
     /// force at ξ, in closed form. For x ≤ ξ, with λ² = T/EI (partial fractions of
@@ -368,7 +500,12 @@ mod tests {
     #[test]
     fn the_seed_string_keeps_the_modes_below_20_khz_and_below_nyquist() {
         let mut modes = ModeSet::new();
-        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, AUDIBLE_LIMIT_HZ);
+        modes.configure(
+            &StringParameters::SEED,
+            1.0 / 44_100.0,
+            AUDIBLE_LIMIT_HZ,
+            None,
+        );
         let count = modes.count();
         let top = modes.angular_frequency[count - 1] / (2.0 * PI);
         assert!(top < NYQUIST_GUARD * 44_100.0, "{top}");
@@ -410,7 +547,7 @@ mod tests {
         taut.bending_stiffness_n_m2 = 0.0;
         for string in [StringParameters::SEED, taut] {
             let mut modes = ModeSet::new();
-            modes.configure(&string, 1.0 / 44_100.0, AUDIBLE_LIMIT_HZ);
+            modes.configure(&string, 1.0 / 44_100.0, AUDIBLE_LIMIT_HZ, None);
             for &(x, xi) in &[(0.040, 0.0465), (0.0465, 0.040), (0.3, 0.3), (0.01, 0.6)] {
                 let closed = modes.static_compliance_m_n(x, xi);
                 let series = compliance_series(&string, x, xi, 2_000_000);
@@ -425,7 +562,12 @@ mod tests {
     #[test]
     fn the_residual_compliance_is_the_truncated_modes_part() {
         let mut modes = ModeSet::new();
-        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, AUDIBLE_LIMIT_HZ);
+        modes.configure(
+            &StringParameters::SEED,
+            1.0 / 44_100.0,
+            AUDIBLE_LIMIT_HZ,
+            None,
+        );
         let (x, xi) = (0.040, 0.0465);
         let (mut row_x, mut row_xi) = (vec![0.0; MODE_CAPACITY], vec![0.0; MODE_CAPACITY]);
         modes.shape_row(x, &mut row_x);
@@ -446,7 +588,12 @@ mod tests {
     #[test]
     fn shape_rows_are_the_scaled_sines() {
         let mut modes = ModeSet::new();
-        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, AUDIBLE_LIMIT_HZ);
+        modes.configure(
+            &StringParameters::SEED,
+            1.0 / 44_100.0,
+            AUDIBLE_LIMIT_HZ,
+            None,
+        );
         let mut row = vec![0.0; MODE_CAPACITY];
         modes.shape_row(0.0465, &mut row);
         for k in 0..modes.count() {

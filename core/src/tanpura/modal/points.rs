@@ -428,7 +428,7 @@ mod tests {
     #[test]
     fn coupling_is_symmetric_and_its_diagonal_positive() {
         let mut modes = ModeSet::new();
-        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, 20_000.0);
+        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, 20_000.0, None);
         let thread = ThreadSettings::SEED;
         let mut points = seed_points(1e-3, 1e-3, 0.0);
         points.couple_from(0, &modes, true, &Kernels::detect());
@@ -450,7 +450,7 @@ mod tests {
     #[test]
     fn a_thread_placed_anew_couples_as_a_whole_placement_does() {
         let mut modes = ModeSet::new();
-        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, 20_000.0);
+        modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, 20_000.0, None);
         let (bridge, thread) = (BridgeSettings::SEED, ThreadSettings::SEED);
         let kernels = Kernels::detect();
         let placed = |thread_spacing_m: f64, thread_offset_m: f64| {
