@@ -266,73 +266,52 @@ impl ModeSet {
     /// at x (`fd::barrier_grid::lagrange_stencil`, eq. 17 of the seed), over √κ_k.
     /// Allocation-free.
     pub fn shape_row(&self, x_m: f64, row: &mut [f64]) {
+        row.fill(0.0);
+        self.for_each_shape(x_m, |index, shape| {
+            if let Some(value) = row.get_mut(index) {
+                *value = shape;
+            }
+        });
+    }
+
+    /// `Σ_k Ψ_k(x) c_k` over the kept modes for the coefficients `coefficient(k)`, m: the
+    /// displacement at x of the modal state `c` (the shapes of [`ModeSet::shape_row`]).
+    /// Allocation-free.
+    pub fn shape_sum(&self, x_m: f64, coefficient: impl Fn(usize) -> f64) -> f64 {
+        let mut sum = 0.0;
+        self.for_each_shape(x_m, |index, shape| sum += shape * coefficient(index));
+        sum
+    }
+
+    /// Calls `visit(k, Ψ_k(x))` for every kept mode, in order.
+    fn for_each_shape(&self, x_m: f64, mut visit: impl FnMut(usize, f64)) {
         if let Some(GridModes { intervals, .. }) = self.grid {
             let (first, weights) =
                 lagrange_stencil(x_m * intervals as f64 / self.length_m, intervals);
-            for (index, value) in row.iter_mut().enumerate() {
-                *value = if index < self.kept {
-                    let angle = (index + 1) as f64 * PI / intervals as f64;
-                    let interpolated: f64 = weights
-                        .iter()
-                        .enumerate()
-                        .map(|(j, weight)| weight * (angle * (first + j) as f64).sin())
-                        .sum();
-                    interpolated * self.inverse_root_stiffness[index]
-                } else {
-                    0.0
-                };
+            for index in 0..self.kept {
+                let angle = (index + 1) as f64 * PI / intervals as f64;
+                let interpolated: f64 = weights
+                    .iter()
+                    .enumerate()
+                    .map(|(j, weight)| weight * (angle * (first + j) as f64).sin())
+                    .sum();
+                visit(index, interpolated * self.inverse_root_stiffness[index]);
             }
             return;
         }
         let theta = PI * x_m / self.length_m;
         let twice_cos = 2.0 * theta.cos();
         let (mut previous, mut current) = (0.0, theta.sin());
-        for (index, value) in row.iter_mut().enumerate() {
-            if index < self.kept {
-                *value = current * self.inverse_root_stiffness[index];
-                let next = twice_cos * current - previous;
-                previous = current;
-                current = next;
-            } else {
-                *value = 0.0;
-            }
+        for index in 0..self.kept {
+            visit(index, current * self.inverse_root_stiffness[index]);
+            let next = twice_cos * current - previous;
+            previous = current;
+            current = next;
         }
     }
 }
 
 impl ModeSet {
-    /// `Σ_k Ψ_k(x) c_k` over the kept modes for the coefficients `coefficient(k)`, m: the
-    /// displacement at x of the modal state `c` (the sines by their recurrence, grid modes by
-    /// their interpolation, as in [`ModeSet::shape_row`]). Allocation-free.
-    pub fn shape_sum(&self, x_m: f64, coefficient: impl Fn(usize) -> f64) -> f64 {
-        if let Some(GridModes { intervals, .. }) = self.grid {
-            let (first, weights) =
-                lagrange_stencil(x_m * intervals as f64 / self.length_m, intervals);
-            return (0..self.kept)
-                .map(|index| {
-                    let angle = (index + 1) as f64 * PI / intervals as f64;
-                    let interpolated: f64 = weights
-                        .iter()
-                        .enumerate()
-                        .map(|(j, weight)| weight * (angle * (first + j) as f64).sin())
-                        .sum();
-                    interpolated * self.inverse_root_stiffness[index] * coefficient(index)
-                })
-                .sum();
-        }
-        let theta = PI * x_m / self.length_m;
-        let twice_cos = 2.0 * theta.cos();
-        let (mut previous, mut current) = (0.0, theta.sin());
-        let mut sum = 0.0;
-        for index in 0..self.kept {
-            sum += current * self.inverse_root_stiffness[index] * coefficient(index);
-            let next = twice_cos * current - previous;
-            previous = current;
-            current = next;
-        }
-        sum
-    }
-
     /// The static compliance of the whole string (every mode, not only the kept ones) between
     /// two points, m/N: `C(x, ξ) = Σ_k φ_k(x) φ_k(ξ)/κ_k`, the deflection at x under a unit
     /// force at ξ, in closed form. For x ≤ ξ, with λ² = T/EI (partial fractions of
