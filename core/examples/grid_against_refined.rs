@@ -7,12 +7,13 @@
 //! yardstick moves when refined twice more, at six plucks; `-- --space-time KEY VELOCITY
 //! POSITION_M` how far the seed's scheme lies from it at one pluck on grids refined in space or
 //! in time alone; `-- --live-variants KEY VELOCITY POSITION_M` the live tier's string with a
-//! shorter time step or other bridge points; `-- --rate-grid` the live tier's string with and
+//! shorter time step or other bridge points, and on grid modes with the reference's points at
+//! one, two and four times the output rate; `-- --rate-grid` the live tier's string with and
 //! without two residual modes, at the output rate and at four times it, over the whole grid
 //! against the refined string and against the reference (both tuned by linearisation; about
 //! five minutes on two cores); `-- --grid-modes` the same with every mode of the reference's FD
-//! grid instead of the continuous string's (§10). `cargo xtask bench` measures the same without the residual
-//! modes, and caches the refined renders.
+//! grid instead of the continuous string's (§10). `cargo xtask bench` measures the same without
+//! the residual modes, and caches the refined renders.
 //!
 //! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
 //! tier tuned by linearising about its own rest state (no calibration as played), so that the
@@ -200,6 +201,20 @@ fn variants_over_grid(variants: &[(String, ModalVariant)]) {
             against(0, true),
             against(1, true)
         );
+        let worst_at = |measure: fn(&ListeningDifference) -> f64| {
+            points
+                .iter()
+                .zip(&results)
+                .max_by(|a, b| measure(&a.1[column][1]).total_cmp(&measure(&b.1[column][1])))
+                .map(|(point, _)| point.label())
+                .unwrap_or_default()
+        };
+        println!(
+            "{name}, worst against the reference | pitch at {} | band levels at {} | centroid at {}",
+            worst_at(|d| d.sustained_cents.abs()),
+            worst_at(|d| d.band_level_db),
+            worst_at(|d| d.centroid_error)
+        );
     }
 }
 
@@ -327,10 +342,11 @@ fn space_time(args: &[String]) {
 }
 
 /// `--live-variants KEY VELOCITY POSITION_M`: one pluck of the grid on the live tier's string as
-/// it is, run at 2× and 4× the output rate and decimated, and with the bridge's points every 1,
-/// 0.5 and 0.25 mm, against the reference tier and against the yardstick, all tuned by
-/// linearisation: whether the live tier's distance from the reference comes from its time step
-/// or its bridge points (`docs/modal-tanpura.md` §9, "Stop 35").
+/// it is, run at 2× and 4× the output rate and decimated, with the bridge's points every 1,
+/// 0.5 and 0.25 mm, and on grid modes with the reference's points at 1×, 2× and 4×, against the
+/// reference tier and against the yardstick, all tuned by linearisation: whether the live tier's
+/// distance from the reference comes from its time step or its bridge points
+/// (`docs/modal-tanpura.md` §9, "Stop 35"), and the grid modes' from their time step (§10).
 fn live_variants(args: &[String]) {
     let (_, point) = pluck_after(args, "--live-variants");
     let variants = [
@@ -360,6 +376,23 @@ fn live_variants(args: &[String]) {
         .map(|(name, spacing_m)| {
             let variant = ModalVariant {
                 bridge_point_spacing_m: Some(spacing_m),
+                ..ModalVariant::default()
+            };
+            (name, variant)
+        }),
+    )
+    .chain(
+        [
+            ("grid modes, fine points", 1),
+            ("the same at 2x", 2),
+            ("the same at 4x", 4),
+        ]
+        .map(|(name, oversample)| {
+            let variant = ModalVariant {
+                grid_modes: true,
+                bridge_point_spacing_m: Some(0.18e-3),
+                thread_point_spacing_m: Some(0.15e-3),
+                oversample,
                 ..ModalVariant::default()
             };
             (name, variant)

@@ -16,8 +16,9 @@
 //!
 //! With [`GridModes`] (section 10) the modes are instead those of the seed's FD grid of N
 //! intervals: the sampled sines `sin(kπi/N)`, k = 1 … N − 1, all kept, with `β_k²` replaced by
-//! `μ_k = (4/Δx²) sin²(kπ/2N)` in κ_k and ω_k, each frequency lowered by the FD's trapezoidal
-//! rule to `(2/Δt_FD) atan(ω_k Δt_FD/2)` in the recursion, shapes at a point by the FD's cubic
+//! `μ_k = (4/Δx²) sin²(kπ/2N)` in κ_k and ω_k, each mode's poles moved as the FD's trapezoidal
+//! rule moves them (the bilinear transform at Δt_FD: [`trapezoidal_equivalent`]; without losses
+//! `(2/Δt_FD) atan(ω_k Δt_FD/2)`) in the recursion, shapes at a point by the FD's cubic
 //! Lagrange interpolation of the nodes, and the nut weight the FD operator's nut force of the
 //! sampled sine (zero above the output band, which the FD tiers' decimator removes).
 
@@ -219,14 +220,14 @@ impl ModeSet {
                 break;
             }
             let decay = 0.5 * string.gamma_per_s + 0.5 * string.eta_s * omega * omega;
-            // The grid's trapezoidal rule lowers each frequency to (2/Δt) atan(ωΔt/2).
-            let heard_omega = match grid {
+            // The grid's trapezoidal rule moves each mode's poles (`trapezoidal_equivalent`).
+            let (heard_omega, heard_decay) = match grid {
                 Some(GridModes { time_step_s, .. }) => {
-                    2.0 / time_step_s * (0.5 * omega * time_step_s).atan()
+                    trapezoidal_equivalent(omega, decay, time_step_s)
                 }
-                None => omega,
+                None => (omega, decay),
             };
-            let (a, b, det) = recursion_coefficients(heard_omega, decay, time_step_s);
+            let (a, b, det) = recursion_coefficients(heard_omega, heard_decay, time_step_s);
             let root = stiffness.sqrt();
             self.stiffness[index] = stiffness;
             self.inverse_root_stiffness[index] = 1.0 / root;
@@ -367,6 +368,35 @@ impl Default for ModeSet {
     }
 }
 
+/// The `(ω, σ)` whose exactly sampled oscillator has the poles the FD scheme's trapezoidal rule
+/// at step `h` gives `q̈ + 2σq̇ + ω²q = 0`: its step is the bilinear transform of the continuous
+/// poles, `z = (1 + s h/2)/(1 − s h/2)` (the FD's step matrix `(1 + γh/2) I + (1 + 2η/h) D` per
+/// mode, `fd/operator.rs`), and `s' = ln z / h`. Without losses `ω' = (2/h) atan(ωh/2)`, the
+/// dispersion `tanpura_invariants.rs` holds the FD string to. An overdamped pair whose transform
+/// leaves the positive axis (σ beyond 2/h) keeps its continuous poles.
+pub fn trapezoidal_equivalent(omega: f64, decay: f64, h: f64) -> (f64, f64) {
+    let half = 0.5 * h;
+    if decay < omega {
+        let damped = (omega * omega - decay * decay).sqrt();
+        let magnitude_squared = ((1.0 - decay * half).powi(2) + (damped * half).powi(2))
+            / ((1.0 + decay * half).powi(2) + (damped * half).powi(2));
+        let angle =
+            (damped * half).atan2(1.0 - decay * half) + (damped * half).atan2(1.0 + decay * half);
+        let heard_decay = -0.5 * magnitude_squared.ln() / h;
+        let heard_damped = angle / h;
+        (heard_damped.hypot(heard_decay), heard_decay)
+    } else {
+        let spread = (decay * decay - omega * omega).sqrt();
+        let transformed = |s: f64| (1.0 + s * half) / (1.0 - s * half);
+        let (slow, fast) = (transformed(-decay + spread), transformed(-decay - spread));
+        if slow <= 0.0 || fast <= 0.0 {
+            return (omega, decay);
+        }
+        let (slow, fast) = (slow.ln() / h, fast.ln() / h);
+        ((slow * fast).sqrt(), -0.5 * (slow + fast))
+    }
+}
+
 /// `(a, b, det)` of the recursion whose poles are those of `q̈ + 2σq̇ + ω²q = 0` sampled at Δt.
 pub fn recursion_coefficients(omega: f64, decay: f64, time_step_s: f64) -> (f64, f64, f64) {
     if decay < omega {
@@ -459,6 +489,46 @@ mod tests {
             p = s - p;
         }
         assert!((r - force).abs() < 1e-12);
+    }
+
+    /// The equivalent oscillator sampled at h has the trapezoidal rule's poles, the bilinear
+    /// transform of the continuous ones (checked on the characteristic polynomial of the FD's
+    /// per-mode step: `(1 + σh + ω²h²/4) z² − (2 − ω²h²/2) z + (1 − σh + ω²h²/4)`).
+    #[test]
+    fn the_trapezoidal_equivalent_has_the_fd_steps_poles() {
+        let h = 1.0 / 176_400.0;
+        for (omega, decay) in [
+            (2.0 * PI * 191.0, 0.3),
+            (2.0 * PI * 9_000.0, 2_000.0),
+            (2.0 * PI * 31_000.0, 30_000.0),
+            (1_000.0, 5_000.0),
+        ] {
+            let (heard_omega, heard_decay) = trapezoidal_equivalent(omega, decay, h);
+            // The sampled equivalent's poles: z = e^{s'h}, s' = −σ' ± √(σ'² − ω'²).
+            let (sum, product) = if heard_decay < heard_omega {
+                let damped = (heard_omega.powi(2) - heard_decay.powi(2)).sqrt();
+                let e = (-heard_decay * h).exp();
+                (2.0 * e * (damped * h).cos(), e * e)
+            } else {
+                let spread = (heard_decay.powi(2) - heard_omega.powi(2)).sqrt();
+                let (slow, fast) = (
+                    ((-heard_decay + spread) * h).exp(),
+                    ((-heard_decay - spread) * h).exp(),
+                );
+                (slow + fast, slow * fast)
+            };
+            let w = omega * omega * h * h / 4.0;
+            let lead = 1.0 + decay * h + w;
+            let expected_sum = (2.0 - 2.0 * w) / lead;
+            let expected_product = (1.0 - decay * h + w) / lead;
+            assert!(
+                (sum - expected_sum).abs() < 1e-12 && (product - expected_product).abs() < 1e-12,
+                "ω {omega}, σ {decay}: {sum} {product} against {expected_sum} {expected_product}"
+            );
+        }
+        // Without losses, the FD's dispersion (2/h) atan(ωh/2).
+        let (heard, decay) = trapezoidal_equivalent(1e5, 0.0, h);
+        assert!((heard - 2.0 / h * (0.5e5 * h).atan()).abs() < 1e-9 * heard && decay == 0.0);
     }
 
     #[test]
