@@ -23,7 +23,7 @@
 //! `--grid-modes`: section 10).
 
 use javari_core::analysis::listening::{compare, ListeningDifference};
-use javari_core::analysis::playing_range::{full_grid, GridPoint};
+use javari_core::analysis::playing_range::{full_grid, GridPoint, CREST_KEYS};
 use javari_core::analysis::refined::{
     grid_pluck, grid_render_linearised, grid_render_refined, modal_variant_pluck,
     reference_pluck_on_grid, refined_reference_pluck, yardstick_grid, ModalVariant,
@@ -149,13 +149,9 @@ fn grid_modes_grid() {
     variants_over_grid(&variants);
 }
 
-/// The keys where the reference's grid first rests the string on the crest (the bench's
-/// `CREST_KEYS`), left out of the second summary.
-const CREST_KEYS: std::ops::RangeInclusive<u8> = 48..=54;
-
 /// Each variant of the live tier's string over the whole grid, against N = 800 at 16× and
 /// against the reference, all tuned by linearisation: worst / median of each measure, over every
-/// pluck and over the plucks away from [`CREST_KEYS`].
+/// pluck and over the plucks away from the crest keys (`playing_range::CREST_KEYS`).
 fn variants_over_grid(variants: &[(String, ModalVariant)]) {
     let points = full_grid();
     let results = measure_all(&points, |point| {
@@ -197,7 +193,9 @@ fn variants_over_grid(variants: &[(String, ModalVariant)]) {
             against(1, false)
         );
         println!(
-            "{name}, away from keys 48-54 | against N = 800: {} | against the reference: {}",
+            "{name}, away from keys {}-{} | against N = 800: {} | against the reference: {}",
+            CREST_KEYS.start(),
+            CREST_KEYS.end(),
             against(0, true),
             against(1, true)
         );

@@ -26,8 +26,8 @@ use javari_core::analysis::listening::{
     compare, sustained_pitch_hz, ListeningDifference, LOW_BANDS_TO_HZ,
 };
 use javari_core::analysis::playing_range::{
-    calibration_request, full_grid, render_as_played, settings_for, GridPoint, KEYS, NOTE_SECONDS,
-    PLUCK_POSITIONS_M,
+    calibration_request, full_grid, render_as_played, settings_for, GridPoint, CREST_KEYS, KEYS,
+    NOTE_SECONDS, PLUCK_POSITIONS_M,
 };
 use javari_core::analysis::refined::{
     grid_render_linearised, grid_render_refined, yardstick_grid, YARDSTICK_REFINEMENT,
@@ -46,11 +46,6 @@ pub struct TierOverGrid {
     pub tier: &'static str,
     pub points: Vec<(GridPoint, ListeningDifference)>,
 }
-
-/// The crest keys: where the string at rest lies at the edge of the bridge's crest, and where
-/// the reference's grid is the least resolved scheme (README, *Where the targets are missed*;
-/// `docs/modal-tanpura.md` §9; `core/tests/tanpura_crest_threshold.rs`).
-pub const CREST_KEYS: std::ops::RangeInclusive<u8> = 48..=54;
 
 /// Worst case and median of one measure over the grid, and where the worst lies.
 #[derive(Debug, Clone)]

@@ -19,6 +19,11 @@ pub const VELOCITIES: [u8; 4] = [1, 40, 80, 127];
 pub const PLUCK_POSITIONS_M: [f64; 2] = [0.35, 0.20];
 /// Length of each render, s: the sustained pitch is measured up to 1.5 s.
 pub const NOTE_SECONDS: f64 = 1.6;
+/// The crest keys: where the string at rest lies at the edge of the bridge's crest, and where
+/// the reference's grid is the least resolved scheme (README, *Where the targets are missed*;
+/// `docs/modal-tanpura.md` §9; `core/tests/tanpura_crest_threshold.rs`). The bench and
+/// `examples/grid_against_refined.rs` also report their worst plucks without these keys.
+pub const CREST_KEYS: std::ops::RangeInclusive<u8> = 48..=54;
 
 /// One pluck of the grid.
 #[derive(Debug, Clone, Copy, PartialEq)]
