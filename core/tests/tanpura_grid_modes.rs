@@ -1,11 +1,10 @@
 //! The modal string with the reference's FD grid as its modes (`ModalStringConfig::grid_modes`,
-//! `docs/modal-tanpura.md` §10): every mode of the grid is kept, those above Nyquist included, so
-//! the discrete energy balance of eq. M3 must still hold in contact, and the static problems see
-//! the grid's whole compliance, so the string must rest where the FD string rests. (That its free
-//! partials are the FD scheme's own is checked beside the FD's in `tanpura_invariants.rs`.)
+//! `docs/modal-tanpura.md` §10): every mode of the grid is kept, so the static problems see the
+//! grid's whole compliance and the string must rest where the FD string rests. (Its energy
+//! balance is checked with the other modal strings' in `tanpura_modal.rs`, its free partials
+//! beside the FD's in `tanpura_invariants.rs`.)
 
 use javari_core::analysis::refined::reference_grid_modes;
-use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::fd::barrier_grid::lagrange_stencil;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
@@ -16,54 +15,6 @@ const SAMPLE_RATE: f64 = 44_100.0;
 fn on_the_grid(mut config: ModalStringConfig) -> ModalStringConfig {
     config.grid_modes = Some(reference_grid_modes(SAMPLE_RATE));
     config
-}
-
-#[test]
-fn grid_modes_keep_the_energy_balance_in_contact() {
-    let mut lossless = on_the_grid(ModalStringConfig::REFERENCE.lossless());
-    lossless.track_energy = true;
-    let mut string = ModalString::<f64>::new(lossless);
-    assert_eq!(
-        string.modes().count(),
-        199,
-        "every mode of the 200-interval grid"
-    );
-    string.pluck(&Pluck::default());
-    let initial = string.energy_j();
-    let mut worst_drift = 0.0f64;
-    for _ in 0..(0.5 * SAMPLE_RATE) as usize {
-        string.step();
-        worst_drift = worst_drift.max((string.energy_j() - initial).abs() / initial);
-    }
-    let stats = *string.newton_stats();
-    assert!(
-        stats.steps_without_contact < stats.steps / 10,
-        "the balance is tested in contact: {stats:?}"
-    );
-    assert!(
-        worst_drift <= 1e-10,
-        "relative energy drift {worst_drift:e}"
-    );
-
-    let mut lossy = on_the_grid(ModalStringConfig::REFERENCE);
-    lossy.track_energy = true;
-    let mut string = ModalString::<f64>::new(lossy);
-    string.pluck(&Pluck::default());
-    let initial = string.energy_j();
-    let mut previous = initial;
-    let (mut worst_rise, mut worst_balance) = (0.0f64, 0.0f64);
-    for _ in 0..(0.5 * SAMPLE_RATE) as usize {
-        string.step();
-        let energy = string.energy_j();
-        worst_rise = worst_rise.max((energy - previous) / initial);
-        worst_balance =
-            worst_balance.max((energy + string.cumulative_losses_j() - initial).abs() / initial);
-        previous = energy;
-    }
-    assert!(string.cumulative_losses_j() > 0.0);
-    assert!(worst_rise <= 1e-14, "H rose by {worst_rise:e} of H(0)");
-    assert!(worst_balance <= 1e-10, "balance error {worst_balance:e}");
-    assert_eq!(string.newton_stats().cap_hits, 0);
 }
 
 /// The FD string's rest displacement at `x_m`, by the scheme's own cubic interpolation.

@@ -3,6 +3,7 @@
 //! rising), exact partial frequencies and decay rates in the running string, rest contact depth,
 //! a bounded Newton iteration, determinism, and the f32 tier's agreement with the f64 path.
 
+use javari_core::analysis::refined::reference_grid_modes;
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
 
@@ -18,16 +19,29 @@ fn plucked<T: javari_core::tanpura::modal::lanes::Real>(
 }
 
 /// With and without the truncated modes' static flexibility (which moves the rest state, not
-/// the scheme), and with residual modes (more modes of the same recursion), the lossless H is
-/// conserved.
+/// the scheme), with residual modes (more modes of the same recursion), and with the reference
+/// grid's 199 modes (section 10, those above Nyquist included), the lossless H is conserved.
 #[test]
 fn lossless_energy_is_conserved_to_1e_10_in_contact() {
-    for (flexible, residual_modes) in [(true, 0), (false, 0), (false, 2)] {
+    for (flexible, residual_modes, grid) in [
+        (true, 0, false),
+        (false, 0, false),
+        (false, 2, false),
+        (false, 0, true),
+    ] {
         let mut config = ModalStringConfig::REFERENCE.lossless();
         config.track_energy = true;
         config.static_flexibility = flexible;
         config.residual_modes = residual_modes;
+        config.grid_modes = grid.then(|| reference_grid_modes(SAMPLE_RATE));
         let mut string = plucked::<f64>(config);
+        if grid {
+            assert_eq!(
+                string.modes().count(),
+                199,
+                "every mode of the 200-interval grid"
+            );
+        }
         let initial = string.energy_j();
         let mut worst = 0.0f64;
         for _ in 0..SAMPLE_RATE as usize {
@@ -42,7 +56,8 @@ fn lossless_energy_is_conserved_to_1e_10_in_contact() {
         assert_eq!(string.cumulative_losses_j(), 0.0);
         assert!(
             worst <= 1e-10,
-            "relative energy drift {worst:e} (flexible: {flexible}, residual modes: {residual_modes})"
+            "relative energy drift {worst:e} (flexible: {flexible}, residual modes: \
+             {residual_modes}, grid modes: {grid})"
         );
     }
 }
@@ -123,6 +138,22 @@ fn residual_modes_keep_the_balance_and_let_the_string_settle_on_the_crest() {
         residual_landings, 0,
         "residual modes: the string still strikes the crest"
     );
+}
+
+/// Grid modes (section 10): the lossy balance holds with every mode of the reference's grid.
+#[test]
+fn grid_modes_keep_the_lossy_balance() {
+    let mut config = ModalStringConfig::REFERENCE;
+    config.track_energy = true;
+    config.grid_modes = Some(reference_grid_modes(SAMPLE_RATE));
+    let (string, worst_increase, worst_balance) = lossy_run(config, 0.5);
+    assert!(string.cumulative_losses_j() > 0.0);
+    assert!(
+        worst_increase <= 1e-14,
+        "H increased by {worst_increase:e} of H(0)"
+    );
+    assert!(worst_balance <= 1e-10, "balance error {worst_balance:e}");
+    assert_eq!(string.newton_stats().cap_hits, 0);
 }
 
 #[test]
