@@ -34,6 +34,7 @@
 use javari_core::analysis::cents;
 use javari_core::analysis::listening::{compare, sustained_pitch_hz};
 use javari_core::analysis::playing_range::NOTE_SECONDS;
+use javari_core::engine::pitch::note_to_hz;
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::ModalString;
@@ -73,10 +74,6 @@ fn deepest_rest_gap_um(scheme: Scheme, tension_n: f64) -> f64 {
     }
 }
 
-fn key_hz(key: u8) -> f64 {
-    440.0 * ((f64::from(key) - 69.0) / 12.0).exp2()
-}
-
 fn main() {
     let arguments: Vec<String> = std::env::args().skip(1).collect();
     let mut keys: Vec<u8> = arguments
@@ -93,7 +90,7 @@ fn main() {
         .unwrap_or(Pluck::default().position_m);
     let seed_tension = FdStringConfig::REFERENCE.string.tension_n;
     let seed_hz = FdString::new(FdStringConfig::REFERENCE).linearised_fundamental_hz();
-    let tension_of = |key: u8| seed_tension * (key_hz(key) / seed_hz).powi(2);
+    let tension_of = |key: u8| seed_tension * (note_to_hz(key) / seed_hz).powi(2);
     println!(
         "The seed's string at the tension of each key (seed: {seed_tension:.2} N, {seed_hz:.2} Hz \
          on the reference grid)"
@@ -170,7 +167,7 @@ fn main() {
     for (scheme, row) in dynamic_schemes.iter().zip(&renders) {
         print!("| {} |", scheme.name());
         for (&key, forces) in keys.iter().zip(row) {
-            let pitch = |force: &[f64]| sustained_pitch_hz(force, OUTPUT_RATE_HZ, key_hz(key));
+            let pitch = |force: &[f64]| sustained_pitch_hz(force, OUTPUT_RATE_HZ, note_to_hz(key));
             let soft = pitch(&forces[0]);
             let listed: Vec<String> = forces[1..]
                 .iter()
@@ -192,7 +189,7 @@ fn main() {
         for (k, forces) in row.iter().enumerate() {
             let (mut pitch, mut bands, mut centroid) = (0.0f64, 0.0f64, 0.0f64);
             for (force, fine) in forces.iter().zip(&renders[FINE][k]) {
-                let difference = compare(force, fine, OUTPUT_RATE_HZ, key_hz(keys[k]));
+                let difference = compare(force, fine, OUTPUT_RATE_HZ, note_to_hz(keys[k]));
                 pitch = pitch.max(difference.sustained_cents.abs());
                 bands = bands.max(difference.band_level_db);
                 centroid = centroid.max(100.0 * difference.centroid_error);

@@ -5,6 +5,7 @@
 //! beside the FD's in `tanpura_invariants.rs`.)
 
 use javari_core::analysis::refined::reference_grid_modes;
+use javari_core::engine::pitch::note_to_hz;
 use javari_core::tanpura::fd::barrier_grid::lagrange_stencil;
 use javari_core::tanpura::fd::{FdString, FdStringConfig};
 use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
@@ -37,8 +38,7 @@ fn grid_modes_rest_where_the_reference_grid_rests() {
     let seed = FdStringConfig::REFERENCE;
     let seed_hz = FdString::new(seed).linearised_fundamental_hz();
     for key in [49u8, 51, 54, 60] {
-        let key_hz = 440.0 * ((f64::from(key) - 69.0) / 12.0).exp2();
-        let tension_n = seed.string.tension_n * (key_hz / seed_hz).powi(2);
+        let tension_n = seed.string.tension_n * (note_to_hz(key) / seed_hz).powi(2);
         let mut fd_config = seed;
         fd_config.string.tension_n = tension_n;
         let mut fd = FdString::new(fd_config);
