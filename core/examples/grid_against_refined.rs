@@ -149,6 +149,36 @@ fn grid_modes_grid() {
     variants_over_grid(&variants);
 }
 
+/// `--grid-spacings`: the live tier's string on every mode of the reference's grid, the contact
+/// condensed on the grid's nodes (`docs/modal-tanpura.md` §11), with contact points from the
+/// reference's spacing (0.18 mm on the bridge, 0.15 mm on the thread) to the tier's: how coarse
+/// the points may be before the crest keys part from the reference.
+fn grid_spacings_grid() {
+    let variants = [
+        (0.18e-3, 0.15e-3),
+        (0.36e-3, 0.15e-3),
+        (0.5e-3, 0.25e-3),
+        (0.72e-3, 0.3e-3),
+        (1.0e-3, 0.5e-3),
+    ]
+    .map(|(bridge_m, thread_m)| {
+        (
+            format!(
+                "grid modes, points every {:.2} / {:.2} mm",
+                1e3 * bridge_m,
+                1e3 * thread_m
+            ),
+            ModalVariant {
+                grid_modes: true,
+                bridge_point_spacing_m: Some(bridge_m),
+                thread_point_spacing_m: Some(thread_m),
+                ..ModalVariant::default()
+            },
+        )
+    });
+    variants_over_grid(&variants);
+}
+
 /// Each variant of the live tier's string over the whole grid, against N = 800 at 16× and
 /// against the reference, all tuned by linearisation: worst / median of each measure, over every
 /// pluck and over the plucks away from the crest keys (`playing_range::CREST_KEYS`).
@@ -430,6 +460,10 @@ fn main() {
     }
     if args.iter().any(|arg| arg == "--live-variants") {
         live_variants(&args);
+        return;
+    }
+    if args.iter().any(|arg| arg == "--grid-spacings") {
+        grid_spacings_grid();
         return;
     }
     if args.iter().any(|arg| arg == "--grid-modes") {

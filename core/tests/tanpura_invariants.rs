@@ -490,6 +490,7 @@ fn grid_modes_ring_at_the_fd_schemes_own_partials() {
     let grid = modal_partials(Some(GridModes {
         intervals: 200,
         time_step_s: 1.0 / SAMPLE_RATE,
+        condensed: false,
     }));
     let continuous = modal_partials(None);
     for n in 0..10 {

@@ -5,7 +5,7 @@
 
 use javari_core::analysis::refined::reference_grid_modes;
 use javari_core::tanpura::excitation::Pluck;
-use javari_core::tanpura::modal::{ModalString, ModalStringConfig};
+use javari_core::tanpura::modal::{GridModes, ModalString, ModalStringConfig};
 
 const SAMPLE_RATE: f64 = 44_100.0;
 const DIAMETER_M: f64 = 0.3e-3;
@@ -20,27 +20,34 @@ fn plucked<T: javari_core::tanpura::modal::lanes::Real>(
 
 /// With and without the truncated modes' static flexibility (which moves the rest state, not
 /// the scheme), with residual modes (more modes of the same recursion), and with the reference
-/// grid's 199 modes (section 10, those above Nyquist included), the lossless H is conserved.
+/// grid's 199 modes (section 10, those above Nyquist included), the contact solved on the points
+/// or condensed on the grid's nodes (section 11, also with points as fine as the reference's
+/// barrier grids), the lossless H is conserved.
 #[test]
 fn lossless_energy_is_conserved_to_1e_10_in_contact() {
     for (flexible, residual_modes, grid) in [
-        (true, 0, false),
-        (false, 0, false),
-        (false, 2, false),
-        (false, 0, true),
+        (true, 0, None),
+        (false, 0, None),
+        (false, 2, None),
+        (false, 0, Some((false, false))),
+        (false, 0, Some((true, false))),
+        (false, 0, Some((true, true))),
     ] {
         let mut config = ModalStringConfig::REFERENCE.lossless();
         config.track_energy = true;
         config.static_flexibility = flexible;
         config.residual_modes = residual_modes;
-        config.grid_modes = grid.then(|| reference_grid_modes(SAMPLE_RATE));
+        if let Some((condensed, fine)) = grid {
+            config = on_the_grid(config, condensed, fine);
+        }
         let mut string = plucked::<f64>(config);
-        if grid {
+        if let Some((condensed, _)) = grid {
             assert_eq!(
                 string.modes().count(),
                 199,
                 "every mode of the 200-interval grid"
             );
+            assert_eq!(string.contact_node_count() > 0, condensed);
         }
         let initial = string.energy_j();
         let mut worst = 0.0f64;
@@ -57,9 +64,23 @@ fn lossless_energy_is_conserved_to_1e_10_in_contact() {
         assert!(
             worst <= 1e-10,
             "relative energy drift {worst:e} (flexible: {flexible}, residual modes: \
-             {residual_modes}, grid modes: {grid})"
+             {residual_modes}, grid modes (condensed, fine points): {grid:?})"
         );
     }
+}
+
+/// `config` on the reference's grid modes (section 10), the contact solved on the points or
+/// condensed on the nodes (section 11), with the reference's barrier spacings if `fine`.
+fn on_the_grid(mut config: ModalStringConfig, condensed: bool, fine: bool) -> ModalStringConfig {
+    config.grid_modes = Some(GridModes {
+        condensed,
+        ..reference_grid_modes(SAMPLE_RATE)
+    });
+    if fine {
+        config.bridge_point_spacing_m = 0.18e-3;
+        config.thread_point_spacing_m = 0.15e-3;
+    }
+    config
 }
 
 /// Plucks a string of `config` (losses booked) and runs it for `seconds`; returns it with the
@@ -140,20 +161,27 @@ fn residual_modes_keep_the_balance_and_let_the_string_settle_on_the_crest() {
     );
 }
 
-/// Grid modes (section 10): the lossy balance holds with every mode of the reference's grid.
+/// Grid modes (section 10): the lossy balance holds with every mode of the reference's grid,
+/// the contact solved on the points or condensed on the nodes (section 11).
 #[test]
 fn grid_modes_keep_the_lossy_balance() {
-    let mut config = ModalStringConfig::REFERENCE;
-    config.track_energy = true;
-    config.grid_modes = Some(reference_grid_modes(SAMPLE_RATE));
-    let (string, worst_increase, worst_balance) = lossy_run(config, 0.5);
-    assert!(string.cumulative_losses_j() > 0.0);
-    assert!(
-        worst_increase <= 1e-14,
-        "H increased by {worst_increase:e} of H(0)"
-    );
-    assert!(worst_balance <= 1e-10, "balance error {worst_balance:e}");
-    assert_eq!(string.newton_stats().cap_hits, 0);
+    for (condensed, fine) in [(false, false), (true, false), (true, true)] {
+        let mut config = on_the_grid(ModalStringConfig::REFERENCE, condensed, fine);
+        config.track_energy = true;
+        let (string, worst_increase, worst_balance) = lossy_run(config, 0.5);
+        let case = format!("condensed: {condensed}, fine points: {fine}");
+        assert_eq!(string.contact_node_count() > 0, condensed, "{case}");
+        assert!(string.cumulative_losses_j() > 0.0, "{case}");
+        assert!(
+            worst_increase <= 1e-14,
+            "H increased by {worst_increase:e} of H(0) ({case})"
+        );
+        assert!(
+            worst_balance <= 1e-10,
+            "balance error {worst_balance:e} ({case})"
+        );
+        assert_eq!(string.newton_stats().cap_hits, 0, "{case}");
+    }
 }
 
 #[test]

@@ -148,7 +148,8 @@ pub struct ModalVariant {
 }
 
 /// The reference tier's grid as modes for a modal string at `output_sample_rate_hz`: its
-/// intervals, and the time step of its oversampled trapezoidal rule.
+/// intervals, and the time step of its oversampled trapezoidal rule; the contact condensed on
+/// the grid's nodes.
 pub fn reference_grid_modes(output_sample_rate_hz: f64) -> GridModes {
     let tier = Quality::Reference
         .fd_tier()
@@ -156,6 +157,7 @@ pub fn reference_grid_modes(output_sample_rate_hz: f64) -> GridModes {
     GridModes {
         intervals: tier.intervals,
         time_step_s: 1.0 / (output_sample_rate_hz * tier.oversample as f64),
+        condensed: true,
     }
 }
 

@@ -36,6 +36,7 @@
 mod block;
 pub mod lanes;
 pub mod modes;
+pub mod nodal;
 pub mod points;
 pub mod solve;
 pub mod step;
@@ -49,6 +50,7 @@ use crate::tanpura::tier_string::weighted_pickup_n;
 use lanes::{padded_lanes, AdvanceAndPrepare, Dots, Kernels, LeadingDots, Real, LANE_PADDING};
 pub use modes::GridModes;
 use modes::{ModeSet, AUDIBLE_LIMIT_HZ, MODE_CAPACITY};
+use nodal::{NodalContact, NODE_CAPACITY};
 use points::{grid_points, ContactPoints};
 use pulp::{Simd, WithSimd};
 use solve::{linearised_fundamental, StaticSolver};
@@ -290,6 +292,13 @@ pub struct ModalString<T: Real> {
     /// Steps since far points were last put to sleep.
     steps_since_sleep_check: usize,
     contact: ContactStep,
+    /// The contact condensed on the grid's nodes (section 11), in use when `nodal_in_use`.
+    nodal: NodalContact,
+    nodal_in_use: bool,
+    /// V rows in T, `NODE_CAPACITY × MODE_CAPACITY` (the nodes' projections), and the nodal
+    /// force changes in T.
+    node_shapes: CacheAligned<T>,
+    node_forces: Vec<T>,
     solver: StaticSolver,
     loaded_forces: Vec<T>,
     /// r_rest (f64) and a scratch row.
@@ -334,6 +343,10 @@ impl<T: Real> ModalString<T> {
             thread_offset_m: 0.0,
             steps_since_sleep_check: 0,
             contact: ContactStep::new(points),
+            nodal: NodalContact::new(points),
+            nodal_in_use: false,
+            node_shapes: CacheAligned::new(NODE_CAPACITY * MODE_CAPACITY, T::default()),
+            node_forces: vec![T::default(); NODE_CAPACITY],
             solver: StaticSolver::new(points + finger),
             loaded_forces: vec![T::default(); points],
             rest_modal: vec![0.0; MODE_CAPACITY],
@@ -436,6 +449,27 @@ impl<T: Real> ModalString<T> {
             self.update_rest_state();
         } else {
             self.place_thread_lattice();
+        }
+        self.configure_nodes();
+    }
+
+    /// With condensed grid modes, the nodes the points reach, their shapes and compliance
+    /// (section 11); the point-level solve otherwise, or when the points reach more than
+    /// [`NODE_CAPACITY`] nodes.
+    fn configure_nodes(&mut self) {
+        self.nodal_in_use = match self.config.grid_modes {
+            Some(grid) if grid.condensed => self.nodal.configure(
+                &self.points,
+                &self.modes,
+                grid.intervals,
+                self.config.string.length_m,
+            ),
+            _ => false,
+        };
+        if self.nodal_in_use {
+            for (target, source) in self.node_shapes.iter_mut().zip(&self.nodal.node_shapes) {
+                *target = T::from_f64(*source);
+            }
         }
     }
 
@@ -653,6 +687,26 @@ impl<T: Real> ModalString<T> {
             self.contact.gaps_m[i] = self.modal_gap_m(i);
         }
         self.contact.classify(&self.points, TRACKING_BAND_M);
+        self.classify_nodal();
+    }
+
+    /// The condensed contact's gaps from the point-level one's (exact on entry), and its
+    /// tracking from scratch.
+    fn classify_nodal(&mut self) {
+        if self.nodal_in_use {
+            let count = self.points.len();
+            self.nodal.gaps_m[..count].copy_from_slice(&self.contact.gaps_m[..count]);
+            self.nodal.classify(TRACKING_BAND_M);
+        }
+    }
+
+    /// The gaps of the points after the last step, from the solve in use.
+    fn current_gaps_m(&self) -> &[f64] {
+        if self.nodal_in_use {
+            &self.nodal.gaps_m
+        } else {
+            &self.contact.gaps_m
+        }
     }
 
     /// Point i's gap from the modal state, `a_rest,i − Ψ_i r̃`, in f64 (a step carries the
@@ -676,6 +730,7 @@ impl<T: Real> ModalString<T> {
         let count = self.points.len();
         self.contact.gaps_m[..count].copy_from_slice(&self.points.rest_gaps_m[..count]);
         self.contact.classify(&self.points, TRACKING_BAND_M);
+        self.classify_nodal();
         self.prepare_free_step();
         self.external_work_j -= energy_before;
         self.nut_force_change_n = 0.0;
@@ -706,6 +761,10 @@ impl<T: Real> ModalString<T> {
     /// [`ModalString::step`] on the vector unit `simd`.
     #[inline(always)]
     fn step_on<S: Simd>(&mut self, simd: S) {
+        if self.nodal_in_use {
+            self.step_on_nodes(simd);
+            return;
+        }
         // The kernels run over the kept modes, padded to whole registers; `step` holds s_free.
         let lanes = self.lanes;
         // Every awake point's free step Ψ_i s_free, one dot product per point; far points are
@@ -791,6 +850,67 @@ impl<T: Real> ModalString<T> {
         }
     }
 
+    /// [`ModalString::step`] with the contact condensed on the grid's nodes (section 11): the
+    /// nodes' free steps, Newton on the nodes, the modes forced through the node rows.
+    #[inline(always)]
+    fn step_on_nodes<S: Simd>(&mut self, simd: S) {
+        let lanes = self.lanes;
+        let nodes = self.nodal.node_count();
+        LeadingDots {
+            matrix: &self.node_shapes,
+            stride: MODE_CAPACITY,
+            x: &self.step[..lanes],
+            out: &mut self.nodal.node_free_steps_m[..nodes],
+        }
+        .with_simd(simd);
+        let outcome = self.nodal.step(
+            &self.config.newton,
+            self.config.track_energy,
+            TRACKING_BAND_M,
+            2.0 * TRACKING_BAND_M,
+        );
+        self.stats.record(outcome.iterations, outcome.converged);
+        if self.config.track_energy {
+            self.cumulative_losses_j += outcome.damping_loss_j;
+        }
+        let (loaded, changes) = self.nodal.loaded();
+        for (value, change) in self.node_forces.iter_mut().zip(changes) {
+            *value = T::from_f64(*change);
+        }
+        let nut_change = AdvanceAndPrepare {
+            a: &self.a[..lanes],
+            b: &self.b[..lanes],
+            c: &self.nut_weights[..lanes],
+            matrix: &self.node_shapes,
+            stride: MODE_CAPACITY,
+            rows: loaded,
+            forces: &self.node_forces[..loaded.len()],
+            work: &mut self.whole_step[..lanes],
+            s: &mut self.step[..lanes],
+            r: &mut self.modal[..lanes],
+            p: &mut self.velocity[..lanes],
+        }
+        .with_simd(simd);
+        if self.config.track_energy {
+            self.cumulative_losses_j += (0..self.modes.count())
+                .map(|k| {
+                    let s = self.whole_step[k].to_f64();
+                    self.modes.loss_factor[k] * s * s
+                })
+                .sum::<f64>();
+        }
+        let bridge_change = outcome.force_change_n;
+        self.nut_force_change_n = nut_change;
+        self.bridge_force_change_n = bridge_change;
+        self.max_penetration_m = outcome.penetration_m;
+        if !nut_change.is_finite() || !bridge_change.is_finite() {
+            self.non_finite_resets += 1;
+            let external = self.external_work_j;
+            self.settle_to_rest();
+            self.external_work_j = external;
+        }
+    }
+
     /// Puts to sleep the far points that the string's vibration energy cannot carry into
     /// contact before its next excitation ([`ContactStep::sleep_far_points`]): `‖r̃‖ ≤ √(2 H_v)`,
     /// with 1 % more energy for the f32 state's rounding.
@@ -807,6 +927,16 @@ impl<T: Real> ModalString<T> {
             .sleep_far_points(&self.points, &self.shape_norms, reach);
     }
 
+    /// How many grid nodes the contact is condensed on (section 11); 0 when it is solved on the
+    /// points.
+    pub fn contact_node_count(&self) -> usize {
+        if self.nodal_in_use {
+            self.nodal.node_count()
+        } else {
+            0
+        }
+    }
+
     /// How many contact points are awake (the others provably cannot touch before the next
     /// excitation, so their free steps are not computed).
     pub fn awake_point_count(&self) -> usize {
@@ -817,6 +947,7 @@ impl<T: Real> ModalString<T> {
     /// a freshly built string.
     fn forget_motion_history(&mut self) {
         self.contact.forget_corrections();
+        self.nodal.forget_corrections();
     }
 
     /// `Σ_k Ψ_k(x) c_k` for modal coefficients `c_k`, with the sines by recurrence (no scratch,
@@ -954,7 +1085,7 @@ impl<T: Real> ModalString<T> {
             .sum();
         self.bridge_force_change_n = (0..self.points.len())
             .map(|i| {
-                self.points.springs_n_m[i] * self.contact.gaps_m[i].max(0.0)
+                self.points.springs_n_m[i] * self.current_gaps_m()[i].max(0.0)
                     - self.points.rest_forces_n[i]
             })
             .sum();
@@ -969,7 +1100,7 @@ impl<T: Real> ModalString<T> {
                 0.5 * r * r + self.modes.kinetic_factor[k] * p * p
             })
             .sum();
-        modes + self.points.excess_energy_j(&self.contact.gaps_m)
+        modes + self.points.excess_energy_j(self.current_gaps_m())
     }
 
     /// H at the rest state, J: the tension over the lowered support, the modes' rest
@@ -1071,7 +1202,7 @@ impl<T: Real> ModalString<T> {
     /// round-off, tested), a sleeping point's as it fell asleep (its true gap stays at least
     /// 10 µm short of contact); [`ModalString::displacement_at_m`] gives the shape anywhere.
     pub fn gaps_m(&self) -> &[f64] {
-        &self.contact.gaps_m[..self.points.len()]
+        &self.current_gaps_m()[..self.points.len()]
     }
 
     /// The points' positions, m: the bridge's first ([`ModalString::bridge_point_count`]), then

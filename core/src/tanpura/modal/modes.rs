@@ -43,6 +43,10 @@ pub const NYQUIST_GUARD: f64 = 0.45;
 pub struct GridModes {
     pub intervals: usize,
     pub time_step_s: f64,
+    /// Solve the contact on the grid's nodes (`nodal.rs`, section 11) instead of on the points
+    /// (`step.rs`): the same scheme, the same iterates up to round-off, at the cost of the
+    /// nodes the stencils reach instead of the points.
+    pub condensed: bool,
 }
 
 impl GridModes {

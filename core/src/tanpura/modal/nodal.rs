@@ -1,0 +1,931 @@
+//! The grid modes' contact solved on the FD grid's nodes (`docs/modal-tanpura.md`, section 11).
+//!
+//! With grid modes (section 10) a contact point sees the cubic Lagrange interpolation of the
+//! grid's nodes (the seed's eq. 17), so its shape row factors: `Ψ_i = L_i V`, with `L_i` the
+//! point's four stencil weights and `V` the scaled sampled sines on the nodes the stencils reach
+//! (`V_jk = sin(kπ n_j/N)/√κ_k`). Everything the step needs from the modes then passes through
+//! those few nodes (about 16 for the seed's bridge and thread, against 170 points at the
+//! reference's spacing):
+//!
+//! - the nodes' free step `Δy_free = V s_free` (one dot product per node), and every point's
+//!   `Δu_i = L_i Δy`;
+//! - the modal force `Ψᵀ ΔF = Vᵀ Lᵀ ΔF = Vᵀ f`, with the nodal force `f = Lᵀ ΔF`;
+//! - the coupling `G = Ψ diag(b) Ψᵀ = L G_N Lᵀ`, `G_N = V diag(b) Vᵀ`, fixed per configuration.
+//!
+//! **Newton on the nodes.** On the set S of nodes that the tracked points' stencils reach, the
+//! step solves `Δy_S = Δy_free,S + G_SS f_S(Δy_S)` (the other nodes follow explicitly once the
+//! forces are known, `Δy = Δy_free + G_{:,S} f_S`). With `H = G_SS⁻¹` (symmetric positive
+//! definite: `G_N` is, all N − 1 modes being kept and b > 0) the residual in force form is
+//! `ρ = f_S − H (Δy_S − Δy_free,S)` and Newton's update solves
+//!
+//! `(H + Σ_i c_i l_i l_iᵀ) δ = ρ`,   `c_i = −∂F_i/∂Δu_i ≥ 0`,
+//!
+//! a symmetric positive definite system of at most |S| unknowns, whatever the number of points
+//! in contact: it is exactly the point-level update of section 4 (`J = I + G C`, multiplied by
+//! `H` on the nodes), so the iterates are the same up to round-off. The iteration stops when
+//! `max|δ| ≤ tolerance`, or exactly when an update leaves every tracked point in the linear case
+//! (in contact or out, before and after the step) it had at the last evaluation. The energy
+//! balance (M3) holds as for the point-level solve: the forces are the same law at the same
+//! steps, and the modes take `Vᵀ f = Ψᵀ ΔF`.
+//!
+//! **Which points Newton sees.** Those within the tracking band of contact, or loaded at rest,
+//! as in section 4. After Newton every point's step is formed from the nodes in one pass over
+//! runs of points that share a stencil (plain arrays the compiler vectorises); if an untracked
+//! point would touch, it joins and the solve is redone before anything moves.
+//!
+//! Hand-written rather than on a linear-algebra crate: the systems have at most
+//! [`NODE_CAPACITY`] unknowns and are solved once or twice per sample on the audio thread;
+//! nothing here allocates after [`NodalContact::new`].
+
+use super::modes::{ModeSet, MODE_CAPACITY};
+use super::points::ContactPoints;
+use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
+use crate::newton::NewtonSettings;
+use crate::tanpura::contact::HuntCrossley;
+use crate::tanpura::fd::barrier_grid::lagrange_stencil;
+use std::f64::consts::PI;
+
+/// The most grid nodes the stencils may reach; a configuration that reaches more runs the
+/// point-level solve (`step.rs`).
+pub const NODE_CAPACITY: usize = 48;
+const _: () = assert!(NODE_CAPACITY <= 64, "the node set is a u64 mask");
+const UNSET: usize = usize::MAX;
+/// The points are evaluated in chunks of this many lanes (loops over fixed arrays that the
+/// compiler vectorises); the per-point arrays are padded by as many.
+const LANES: usize = 8;
+
+/// A point's contact case over a step: the law is linear in the first two.
+const OUT: f64 = 0.0;
+const IN: f64 = 1.0;
+const CROSSING: f64 = 2.0;
+
+/// The ten pairs (j ≤ l) of a stencil's four nodes, for the symmetric `Σ c l lᵀ`.
+const PAIRS: [(usize, usize); 10] = [
+    (0, 0),
+    (0, 1),
+    (0, 2),
+    (0, 3),
+    (1, 1),
+    (1, 2),
+    (1, 3),
+    (2, 2),
+    (2, 3),
+    (3, 3),
+];
+
+/// Consecutive points whose stencils reach the same four nodes.
+#[derive(Debug, Clone, Copy, Default)]
+struct Run {
+    start: usize,
+    end: usize,
+    nodes: [usize; 4],
+}
+
+/// Consecutive tracked points of one run, with their stencil's slots in S.
+#[derive(Debug, Clone, Copy, Default)]
+struct Segment {
+    start: usize,
+    end: usize,
+    slots: [usize; 4],
+}
+
+/// What one step's contact work reports.
+#[derive(Debug, Clone, Copy)]
+pub struct NodalOutcome {
+    pub iterations: u32,
+    pub converged: bool,
+    /// The contact damping's loss over the step, J.
+    pub damping_loss_j: f64,
+    /// The deepest penetration of the tracked points after the step (0 if none), m.
+    pub penetration_m: f64,
+    /// Σ (F_i − F_rest,i) over the points, N.
+    pub force_change_n: f64,
+}
+
+/// The condensed contact of a grid-mode string; allocation-free after [`NodalContact::new`].
+#[derive(Debug, Clone)]
+pub struct NodalContact {
+    /// The grid nodes (indices 1 … N − 1) the points' stencils reach, in order.
+    node_count: usize,
+    grid_nodes: Vec<usize>,
+    /// V rows in f64, `NODE_CAPACITY × MODE_CAPACITY`.
+    pub node_shapes: Vec<f64>,
+    /// G_N, `NODE_CAPACITY × NODE_CAPACITY`.
+    compliance: Vec<f64>,
+    point_count: usize,
+    /// Per point: its stencil's nodes (local indices; a support's entry has weight 0 and names
+    /// the stencil's nearest interior node); its weights by column.
+    stencil_nodes: Vec<[usize; 4]>,
+    weight_columns: [Vec<f64>; 4],
+    runs: Vec<Run>,
+    run_count: usize,
+    /// Per point: the law's ξ and ψ, and the rest force, N.
+    xis: Vec<f64>,
+    psis: Vec<f64>,
+    rest_forces_n: Vec<f64>,
+    /// a_i per point after every step, m.
+    pub gaps_m: Vec<f64>,
+    next_gaps_m: Vec<f64>,
+    /// 0 for an untracked point, −∞ for a tracked one.
+    far_offsets_m: Vec<f64>,
+    /// The tracked points (in order once S is formed).
+    tracked: Vec<usize>,
+    tracked_count: usize,
+    /// Whether the tracked set changed since S and H were formed.
+    set_changed: bool,
+    /// The node set S as a mask over the local nodes (at most [`NODE_CAPACITY`] ≤ 64).
+    set_mask: u64,
+    /// S: its nodes (local indices), each node's slot in S (or UNSET), H = G_SS⁻¹ (stride
+    /// NODE_CAPACITY).
+    set_count: usize,
+    set_nodes: Vec<usize>,
+    node_slots: Vec<usize>,
+    inverse: Vec<f64>,
+    /// The tracked points in segments, and each segment's `Σ c w_j w_l` over [`PAIRS`] at the
+    /// last evaluation.
+    segments: Vec<Segment>,
+    segment_count: usize,
+    segment_stiffness: Vec<[f64; 10]>,
+    /// Per slot: the free step, the iterate and the nodal force change.
+    slot_free: Vec<f64>,
+    slot_steps: Vec<f64>,
+    slot_forces: Vec<f64>,
+    /// Per local node: the free step, the step, and the last accepted step − free step (the
+    /// next step's initial guess).
+    pub node_free_steps_m: Vec<f64>,
+    node_steps_m: Vec<f64>,
+    node_corrections_m: Vec<f64>,
+    /// Per point (the tracked ones' at the last evaluation): step, force, c, case.
+    point_steps: Vec<f64>,
+    point_forces: Vec<f64>,
+    point_stiffnesses: Vec<f64>,
+    cases: Vec<f64>,
+    matrix: Vec<f64>,
+    right_side: Vec<f64>,
+    scratch: Vec<f64>,
+    /// The nodes with a non-zero force change after the step, and the changes, N.
+    loaded_nodes: Vec<usize>,
+    loaded_forces_n: Vec<f64>,
+    loaded_count: usize,
+    /// Whether an untracked point lies within the tracking band after the step.
+    far_point_near: bool,
+}
+
+/// The mid-point force of `contact.rs` (`HuntCrossley::midpoint_force_linear_damping`) for a
+/// point with gap `gap` and step `step`, branch-free (each case's value is formed and one is
+/// taken), so that a loop over lanes vectorises: (F, c = −∂F/∂s, case).
+#[inline(always)]
+fn law_lane(gap: f64, step: f64, xi: f64, psi: f64) -> (f64, f64, f64) {
+    let after = gap - step;
+    let damping = 2.0 * psi * gap.max(0.0);
+    let inverse = 1.0 / step;
+    let (force_in, stiffness_in) = (xi * (2.0 * gap - step) - damping * step, xi + damping);
+    let ratio = gap * inverse;
+    let (force_leaving, stiffness_leaving) = (
+        xi * gap * ratio - damping * step,
+        xi * ratio * ratio + damping,
+    );
+    let (force_entering, stiffness_entering) = (
+        -xi * after * after * inverse,
+        -xi * after * (gap + step) * inverse * inverse,
+    );
+    let (touching, touching_after) = (gap > 0.0, after > 0.0);
+    let force = if touching {
+        if touching_after {
+            force_in
+        } else {
+            force_leaving
+        }
+    } else if touching_after {
+        force_entering
+    } else {
+        0.0
+    };
+    let stiffness = if touching {
+        if touching_after {
+            stiffness_in
+        } else {
+            stiffness_leaving
+        }
+    } else if touching_after {
+        stiffness_entering
+    } else {
+        0.0
+    };
+    let case = if touching == touching_after {
+        if touching {
+            IN
+        } else {
+            OUT
+        }
+    } else {
+        CROSSING
+    };
+    (force, stiffness, case)
+}
+
+/// A chunk of [`LANES`] values of `values` from `start` (the arrays are padded).
+#[inline(always)]
+fn chunk(values: &[f64], start: usize) -> [f64; LANES] {
+    let mut lanes = [0.0; LANES];
+    lanes.copy_from_slice(&values[start..start + LANES]);
+    lanes
+}
+
+impl NodalContact {
+    /// Room for `capacity` points. Allocates.
+    pub fn new(capacity: usize) -> Self {
+        let zeros = |n: usize| vec![0.0; n];
+        let padded = capacity + LANES;
+        Self {
+            node_count: 0,
+            grid_nodes: vec![0; NODE_CAPACITY],
+            node_shapes: zeros(NODE_CAPACITY * MODE_CAPACITY),
+            compliance: zeros(NODE_CAPACITY * NODE_CAPACITY),
+            point_count: 0,
+            stencil_nodes: vec![[0; 4]; capacity],
+            weight_columns: std::array::from_fn(|_| zeros(padded)),
+            runs: vec![Run::default(); capacity],
+            run_count: 0,
+            xis: zeros(padded),
+            psis: zeros(padded),
+            rest_forces_n: zeros(padded),
+            gaps_m: zeros(padded),
+            next_gaps_m: zeros(padded),
+            far_offsets_m: zeros(capacity),
+            tracked: vec![0; capacity],
+            tracked_count: 0,
+            set_changed: true,
+            set_mask: 0,
+            set_count: 0,
+            set_nodes: vec![0; NODE_CAPACITY],
+            node_slots: vec![UNSET; NODE_CAPACITY],
+            inverse: zeros(NODE_CAPACITY * NODE_CAPACITY),
+            segments: vec![Segment::default(); capacity],
+            segment_count: 0,
+            segment_stiffness: vec![[0.0; 10]; capacity],
+            slot_free: zeros(NODE_CAPACITY),
+            slot_steps: zeros(NODE_CAPACITY),
+            slot_forces: zeros(NODE_CAPACITY),
+            node_free_steps_m: zeros(NODE_CAPACITY),
+            node_steps_m: zeros(NODE_CAPACITY),
+            node_corrections_m: zeros(NODE_CAPACITY),
+            point_steps: zeros(padded),
+            point_forces: zeros(padded),
+            point_stiffnesses: zeros(padded),
+            cases: vec![OUT; padded],
+            matrix: zeros(NODE_CAPACITY * NODE_CAPACITY),
+            right_side: zeros(NODE_CAPACITY),
+            scratch: zeros(NODE_CAPACITY),
+            loaded_nodes: vec![0; NODE_CAPACITY],
+            loaded_forces_n: zeros(NODE_CAPACITY),
+            loaded_count: 0,
+            far_point_near: false,
+        }
+    }
+
+    /// How many nodes the points reach (0: not configured).
+    pub fn node_count(&self) -> usize {
+        self.node_count
+    }
+
+    /// The tracked points.
+    pub fn tracked_count(&self) -> usize {
+        self.tracked_count
+    }
+
+    /// The nodes with a non-zero force change after the last step and the changes, N: what
+    /// the modes feel, through the node rows.
+    pub fn loaded(&self) -> (&[usize], &[f64]) {
+        (
+            &self.loaded_nodes[..self.loaded_count],
+            &self.loaded_forces_n[..self.loaded_count],
+        )
+    }
+
+    /// Sets the nodes, their shapes and compliance, and the points' stencils and laws for the
+    /// grid of `intervals` intervals on a string of `length` m. Returns false (and configures
+    /// nothing) when the stencils reach more than [`NODE_CAPACITY`] nodes. Allocation-free.
+    pub fn configure(
+        &mut self,
+        points: &ContactPoints,
+        modes: &ModeSet,
+        intervals: usize,
+        length: f64,
+    ) -> bool {
+        self.node_count = 0;
+        let count = points.len().min(self.stencil_nodes.len());
+        let stencil = |x: f64| lagrange_stencil(x * intervals as f64 / length, intervals);
+        // The interior nodes the stencils reach, in order.
+        let mut node_count = 0;
+        for i in 0..count {
+            let (first, _) = stencil(points.positions_m[i]);
+            for node in first..first + 4 {
+                if node == 0 || node >= intervals || self.grid_nodes[..node_count].contains(&node) {
+                    continue;
+                }
+                if node_count == NODE_CAPACITY {
+                    return false;
+                }
+                self.grid_nodes[node_count] = node;
+                node_count += 1;
+            }
+        }
+        self.grid_nodes[..node_count].sort_unstable();
+        self.node_count = node_count;
+        self.point_count = count;
+        let grid_nodes = &self.grid_nodes[..node_count];
+        let local = |node: usize| {
+            let interior = node.clamp(1, intervals - 1);
+            grid_nodes.iter().position(|&n| n == interior).unwrap_or(0)
+        };
+        for i in 0..count {
+            let (first, weights) = stencil(points.positions_m[i]);
+            for (j, &weight) in weights.iter().enumerate() {
+                let node = first + j;
+                let support = node == 0 || node >= intervals;
+                self.stencil_nodes[i][j] = local(node);
+                self.weight_columns[j][i] = if support { 0.0 } else { weight };
+            }
+            self.xis[i] = points.laws[i].xi;
+            self.psis[i] = points.laws[i].psi;
+            self.rest_forces_n[i] = points.rest_forces_n[i];
+        }
+        self.run_count = 0;
+        for i in 0..count {
+            let nodes = self.stencil_nodes[i];
+            if self.run_count > 0 && self.runs[self.run_count - 1].nodes == nodes {
+                self.runs[self.run_count - 1].end = i + 1;
+            } else {
+                self.runs[self.run_count] = Run {
+                    start: i,
+                    end: i + 1,
+                    nodes,
+                };
+                self.run_count += 1;
+            }
+        }
+        // V and G_N = V diag(b) Vᵀ.
+        let modes_count = modes.count();
+        for (j, &node) in self.grid_nodes[..node_count].iter().enumerate() {
+            let row = &mut self.node_shapes[j * MODE_CAPACITY..(j + 1) * MODE_CAPACITY];
+            row.fill(0.0);
+            for (k, value) in row[..modes_count].iter_mut().enumerate() {
+                let angle = (k + 1) as f64 * PI * node as f64 / intervals as f64;
+                *value = angle.sin() * modes.inverse_root_stiffness[k];
+            }
+        }
+        for j in 0..node_count {
+            for l in 0..=j {
+                let row_j = &self.node_shapes[j * MODE_CAPACITY..j * MODE_CAPACITY + modes_count];
+                let row_l = &self.node_shapes[l * MODE_CAPACITY..l * MODE_CAPACITY + modes_count];
+                let value: f64 = row_j
+                    .iter()
+                    .zip(row_l)
+                    .zip(&modes.b[..modes_count])
+                    .map(|((x, y), b)| x * y * b)
+                    .sum();
+                self.compliance[j * NODE_CAPACITY + l] = value;
+                self.compliance[l * NODE_CAPACITY + j] = value;
+            }
+        }
+        self.node_corrections_m.fill(0.0);
+        self.set_changed = true;
+        self.set_mask = 0;
+        true
+    }
+
+    /// Tracks the points within `band_m` of contact or loaded at rest, from scratch, with the
+    /// gaps in `gaps_m` (exact on entry). Forgets the initial guesses.
+    pub fn classify(&mut self, band_m: f64) {
+        self.tracked_count = 0;
+        for i in 0..self.point_count {
+            let tracked = self.gaps_m[i] > -band_m || self.rest_forces_n[i] != 0.0;
+            self.far_offsets_m[i] = if tracked { f64::NEG_INFINITY } else { 0.0 };
+            if tracked {
+                self.tracked[self.tracked_count] = i;
+                self.tracked_count += 1;
+            }
+            self.point_forces[i] = self.rest_forces_n[i];
+            self.cases[i] = OUT;
+        }
+        self.node_corrections_m.fill(0.0);
+        self.loaded_count = 0;
+        self.set_changed = true;
+        self.set_mask = 0;
+    }
+
+    /// Forgets Newton's initial guesses.
+    pub fn forget_corrections(&mut self) {
+        self.node_corrections_m.fill(0.0);
+    }
+
+    /// S, the nodes the tracked points' stencils reach; the tracked points in order and in
+    /// segments; and H = G_SS⁻¹ (by Cholesky; G_SS is a principal block of the positive
+    /// definite G_N).
+    fn form_set(&mut self) {
+        // In order (insertion: the list is nearly sorted, points join and leave at its edges).
+        let tracked = &mut self.tracked[..self.tracked_count];
+        for t in 1..tracked.len() {
+            let mut u = t;
+            while u > 0 && tracked[u - 1] > tracked[u] {
+                tracked.swap(u - 1, u);
+                u -= 1;
+            }
+        }
+        // S in node order, so that it and H are a function of the node set alone: H is formed
+        // again only when the set changes, not with every point that joins or leaves.
+        let mut mask = 0u64;
+        for &i in &self.tracked[..self.tracked_count] {
+            for &node in &self.stencil_nodes[i] {
+                mask |= 1 << node;
+            }
+        }
+        let new_set = mask != self.set_mask;
+        if new_set {
+            self.set_mask = mask;
+            self.node_slots[..self.node_count].fill(UNSET);
+            self.set_count = 0;
+            for node in 0..self.node_count {
+                if mask & (1 << node) != 0 {
+                    self.node_slots[node] = self.set_count;
+                    self.set_nodes[self.set_count] = node;
+                    self.set_count += 1;
+                }
+            }
+        }
+        self.segment_count = 0;
+        for t in 0..self.tracked_count {
+            let i = self.tracked[t];
+            let slots = self.stencil_nodes[i].map(|node| self.node_slots[node]);
+            let extends = self.segment_count > 0 && {
+                let last = &self.segments[self.segment_count - 1];
+                last.end == i && last.slots == slots
+            };
+            if extends {
+                self.segments[self.segment_count - 1].end = i + 1;
+            } else {
+                self.segments[self.segment_count] = Segment {
+                    start: i,
+                    end: i + 1,
+                    slots,
+                };
+                self.segment_count += 1;
+            }
+        }
+        self.set_changed = false;
+        if new_set {
+            self.invert_set_compliance();
+        }
+    }
+
+    /// H = G_SS⁻¹ by Cholesky (G_SS is a principal block of the positive definite G_N).
+    fn invert_set_compliance(&mut self) {
+        let m = self.set_count;
+        // Cholesky factor of G_SS in `matrix` (lower, stride m), then its inverse column by
+        // column into `inverse`.
+        for a in 0..m {
+            for b in 0..=a {
+                let mut sum =
+                    self.compliance[self.set_nodes[a] * NODE_CAPACITY + self.set_nodes[b]];
+                for k in 0..b {
+                    sum -= self.matrix[a * m + k] * self.matrix[b * m + k];
+                }
+                self.matrix[a * m + b] = if a == b {
+                    sum.max(f64::MIN_POSITIVE).sqrt()
+                } else {
+                    sum / self.matrix[b * m + b]
+                };
+            }
+        }
+        for column in 0..m {
+            let x = &mut self.right_side;
+            x[..m].fill(0.0);
+            x[column] = 1.0;
+            for a in 0..m {
+                let mut sum = x[a];
+                for k in 0..a {
+                    sum -= self.matrix[a * m + k] * x[k];
+                }
+                x[a] = sum / self.matrix[a * m + a];
+            }
+            for a in (0..m).rev() {
+                let mut sum = x[a];
+                for k in a + 1..m {
+                    sum -= self.matrix[k * m + a] * x[k];
+                }
+                x[a] = sum / self.matrix[a * m + a];
+            }
+            for a in 0..m {
+                self.inverse[a * NODE_CAPACITY + column] = x[a];
+            }
+        }
+    }
+
+    /// Every tracked point's step, force, c and case at the iterate on S, in chunks of
+    /// [`LANES`]; the nodal force change on S and each segment's `Σ c w wᵀ`. Returns whether a
+    /// point's case changed since the last evaluation, and whether a point crosses.
+    #[inline(always)]
+    fn evaluate(&mut self) -> (bool, bool) {
+        self.slot_forces[..self.set_count].fill(0.0);
+        let (mut changed, mut crossing) = (false, false);
+        for index in 0..self.segment_count {
+            let segment = self.segments[index];
+            let y = segment.slots.map(|slot| self.slot_steps[slot]);
+            let mut start = segment.start;
+            while start < segment.end {
+                let valid = (segment.end - start).min(LANES);
+                let gaps = chunk(&self.gaps_m, start);
+                let weights = [
+                    chunk(&self.weight_columns[0], start),
+                    chunk(&self.weight_columns[1], start),
+                    chunk(&self.weight_columns[2], start),
+                    chunk(&self.weight_columns[3], start),
+                ];
+                let (xis, psis) = (chunk(&self.xis, start), chunk(&self.psis, start));
+                let (mut steps, mut forces, mut stiffnesses, mut cases) =
+                    ([0.0; LANES], [0.0; LANES], [0.0; LANES], [0.0; LANES]);
+                for l in 0..LANES {
+                    let step = weights[0][l] * y[0]
+                        + weights[1][l] * y[1]
+                        + weights[2][l] * y[2]
+                        + weights[3][l] * y[3];
+                    (forces[l], stiffnesses[l], cases[l]) =
+                        law_lane(gaps[l], step, xis[l], psis[l]);
+                    steps[l] = step;
+                }
+                // Every lane is written (the arrays are padded): a lane past the segment holds
+                // a later point, which its own segment writes again if it is tracked, and whose
+                // values are not read if it is not.
+                let lanes = start..start + LANES;
+                self.point_steps[lanes.clone()].copy_from_slice(&steps);
+                self.point_forces[lanes.clone()].copy_from_slice(&forces);
+                self.point_stiffnesses[lanes.clone()].copy_from_slice(&stiffnesses);
+                for (l, (&case, previous)) in cases.iter().zip(&mut self.cases[lanes]).enumerate() {
+                    if l < valid {
+                        changed |= case != *previous;
+                        crossing |= case == CROSSING;
+                        *previous = case;
+                    }
+                }
+                start += LANES;
+            }
+            // The nodal force change and Σ c w wᵀ over the points that carry a force or a
+            // stiffness.
+            let mut force_sums = [0.0; 4];
+            let mut stiffness_sums = [0.0; 10];
+            for i in segment.start..segment.end {
+                let (change, stiffness) = (
+                    self.point_forces[i] - self.rest_forces_n[i],
+                    self.point_stiffnesses[i],
+                );
+                if change == 0.0 && stiffness == 0.0 {
+                    continue;
+                }
+                let weights = [
+                    self.weight_columns[0][i],
+                    self.weight_columns[1][i],
+                    self.weight_columns[2][i],
+                    self.weight_columns[3][i],
+                ];
+                for (sum, weight) in force_sums.iter_mut().zip(&weights) {
+                    *sum += weight * change;
+                }
+                for (sum, &(j, k)) in stiffness_sums.iter_mut().zip(&PAIRS) {
+                    *sum += stiffness * weights[j] * weights[k];
+                }
+            }
+            for (slot, sum) in segment.slots.iter().zip(force_sums) {
+                self.slot_forces[*slot] += sum;
+            }
+            self.segment_stiffness[index] = stiffness_sums;
+        }
+        (changed, crossing)
+    }
+
+    /// Newton's iteration on S from the iterate in `slot_steps`. Returns (updates, converged).
+    /// Up to 8 and up to 16 nodes (every step of the bench's scenes) the system is solved in
+    /// fixed lanes, padded with the identity; the general path takes more.
+    #[inline(always)]
+    fn newton(&mut self, settings: &NewtonSettings) -> (u32, bool) {
+        match self.set_count {
+            0..=8 => self.newton_in_lanes::<8>(settings),
+            9..=16 => self.newton_in_lanes::<16>(settings),
+            _ => self.newton_general(settings),
+        }
+    }
+
+    /// [`NodalContact::newton`] in `N ≥ |S|` fixed lanes: the same updates.
+    #[inline(always)]
+    fn newton_in_lanes<const N: usize>(&mut self, settings: &NewtonSettings) -> (u32, bool) {
+        let m = self.set_count;
+        let mut inverse = [[0.0; N]; N];
+        for (a, row) in inverse.iter_mut().enumerate() {
+            if a < m {
+                row[..m].copy_from_slice(&self.inverse[a * NODE_CAPACITY..a * NODE_CAPACITY + m]);
+            } else {
+                row[a] = 1.0;
+            }
+        }
+        let mut free = [0.0; N];
+        free[..m].copy_from_slice(&self.slot_free[..m]);
+        self.evaluate();
+        let mut updates = 0;
+        loop {
+            if updates >= settings.max_iterations {
+                return (updates, false);
+            }
+            let mut steps = [0.0; N];
+            steps[..m].copy_from_slice(&self.slot_steps[..m]);
+            let mut forces = [0.0; N];
+            forces[..m].copy_from_slice(&self.slot_forces[..m]);
+            // (H + Σ c l lᵀ) δ = f − H (Δy − Δy_free); the padding solves δ = 0.
+            let mut matrix = inverse;
+            let mut delta = forces;
+            for (value, row) in delta.iter_mut().zip(&inverse) {
+                for b in 0..N {
+                    *value -= row[b] * (steps[b] - free[b]);
+                }
+            }
+            for (segment, sums) in self.segments[..self.segment_count]
+                .iter()
+                .zip(&self.segment_stiffness)
+            {
+                for (&(j, k), &value) in PAIRS.iter().zip(sums) {
+                    let (a, b) = (segment.slots[j], segment.slots[k]);
+                    matrix[a.max(b)][a.min(b)] += value;
+                }
+            }
+            ldl_factor_fixed(&mut matrix);
+            ldl_substitute_fixed(&matrix, &mut delta);
+            let mut largest = 0.0f64;
+            for (step, &change) in self.slot_steps[..m].iter_mut().zip(&delta) {
+                *step += change;
+                largest = largest.max(change.abs());
+            }
+            updates += 1;
+            let (changed, crossing) = self.evaluate();
+            if !(changed || crossing) || largest <= settings.tolerance_m {
+                return (updates, true);
+            }
+        }
+    }
+
+    /// [`NodalContact::newton`] on any number of nodes.
+    fn newton_general(&mut self, settings: &NewtonSettings) -> (u32, bool) {
+        let m = self.set_count;
+        self.evaluate();
+        let mut updates = 0;
+        loop {
+            if updates >= settings.max_iterations {
+                return (updates, false);
+            }
+            // (H + Σ c l lᵀ) δ = f − H (Δy − Δy_free), its lower triangle, stride m.
+            for a in 0..m {
+                let mut rhs = self.slot_forces[a];
+                for b in 0..m {
+                    let h = self.inverse[a * NODE_CAPACITY + b];
+                    rhs -= h * (self.slot_steps[b] - self.slot_free[b]);
+                    self.matrix[a * m + b] = h;
+                }
+                self.right_side[a] = rhs;
+            }
+            for (segment, sums) in self.segments[..self.segment_count]
+                .iter()
+                .zip(&self.segment_stiffness)
+            {
+                for (&(j, k), &value) in PAIRS.iter().zip(sums) {
+                    let (a, b) = (segment.slots[j], segment.slots[k]);
+                    self.matrix[a.max(b) * m + a.min(b)] += value;
+                }
+            }
+            ldl_solve_in_place(
+                &mut self.matrix[..m * m],
+                m,
+                &mut self.right_side[..m],
+                &mut self.scratch[..m],
+            );
+            let mut largest = 0.0f64;
+            for (step, &delta) in self.slot_steps[..m].iter_mut().zip(&self.right_side[..m]) {
+                *step += delta;
+                largest = largest.max(delta.abs());
+            }
+            updates += 1;
+            let (changed, crossing) = self.evaluate();
+            if !(changed || crossing) || largest <= settings.tolerance_m {
+                return (updates, true);
+            }
+        }
+    }
+
+    /// One step's contact with the nodes' free steps in `node_free_steps_m`: Newton on S, then
+    /// every point's step, a far point that would touch joining and the solve redone; the gaps
+    /// move and the tracking follows (`band_m`, `release_m`). Leaves the nodal force changes in
+    /// [`NodalContact::loaded`].
+    #[inline(always)]
+    pub fn step(
+        &mut self,
+        settings: &NewtonSettings,
+        track_energy: bool,
+        band_m: f64,
+        release_m: f64,
+    ) -> NodalOutcome {
+        let n = self.node_count;
+        let mut iterations = 0;
+        let mut converged = true;
+        loop {
+            if self.set_changed {
+                self.form_set();
+            }
+            let m = self.set_count;
+            for slot in 0..m {
+                let node = self.set_nodes[slot];
+                self.slot_free[slot] = self.node_free_steps_m[node];
+                self.slot_steps[slot] =
+                    self.node_free_steps_m[node] + self.node_corrections_m[node];
+            }
+            if self.tracked_count > 0 {
+                let (updates, done) = self.newton(settings);
+                iterations += updates;
+                converged &= done;
+            }
+            // Every node's step: S's from Newton, the others' from the forces on S.
+            for node in 0..n {
+                let slot = self.node_slots[node];
+                self.node_steps_m[node] = if slot != UNSET {
+                    self.slot_steps[slot]
+                } else {
+                    let coupled: f64 = (0..m)
+                        .map(|s| {
+                            self.compliance[node * NODE_CAPACITY + self.set_nodes[s]]
+                                * self.slot_forces[s]
+                        })
+                        .sum();
+                    self.node_free_steps_m[node] + coupled
+                };
+            }
+            // Every point's gap after the step; whether an untracked one would touch, and
+            // whether one then lies within the band.
+            let (mut touches, mut near) = (false, false);
+            for run in &self.runs[..self.run_count] {
+                let y = run.nodes.map(|node| self.node_steps_m[node]);
+                let range = run.start..run.end;
+                let columns = [
+                    &self.weight_columns[0][range.clone()],
+                    &self.weight_columns[1][range.clone()],
+                    &self.weight_columns[2][range.clone()],
+                    &self.weight_columns[3][range.clone()],
+                ];
+                let inputs = self.gaps_m[range.clone()]
+                    .iter()
+                    .zip(&self.far_offsets_m[range.clone()]);
+                for (k, (next, (&gap, &offset))) in self.next_gaps_m[range.clone()]
+                    .iter_mut()
+                    .zip(inputs)
+                    .enumerate()
+                {
+                    let step = columns[0][k] * y[0]
+                        + columns[1][k] * y[1]
+                        + columns[2][k] * y[2]
+                        + columns[3][k] * y[3];
+                    *next = gap - step;
+                    touches |= *next + offset > 0.0;
+                    near |= *next + offset > -band_m;
+                }
+            }
+            self.far_point_near = near;
+            if !touches {
+                break;
+            }
+            for i in 0..self.point_count {
+                if self.far_offsets_m[i] == 0.0 && self.next_gaps_m[i] > 0.0 {
+                    self.far_offsets_m[i] = f64::NEG_INFINITY;
+                    self.tracked[self.tracked_count] = i;
+                    self.tracked_count += 1;
+                    self.point_forces[i] = 0.0;
+                    self.cases[i] = OUT;
+                }
+            }
+            // The redone solve starts from this one's nodal steps.
+            for node in 0..n {
+                self.node_corrections_m[node] =
+                    self.node_steps_m[node] - self.node_free_steps_m[node];
+            }
+            self.set_changed = true;
+        }
+        // The outcome, the nodal loads and the initial guess of the next step.
+        let mut damping_loss_j = 0.0;
+        let mut penetration_m = 0.0f64;
+        let mut force_change_n = 0.0;
+        for &i in &self.tracked[..self.tracked_count] {
+            force_change_n += self.point_forces[i] - self.rest_forces_n[i];
+            if track_energy {
+                let law = HuntCrossley {
+                    xi: self.xis[i],
+                    psi: self.psis[i],
+                };
+                damping_loss_j += law.linear_damping_loss(self.gaps_m[i], self.point_steps[i]);
+            }
+            // The tracked points' gaps from Newton's steps (the pass's arithmetic too).
+            let gap = self.gaps_m[i] - self.point_steps[i];
+            self.next_gaps_m[i] = gap;
+            penetration_m = penetration_m.max(gap);
+        }
+        std::mem::swap(&mut self.gaps_m, &mut self.next_gaps_m);
+        self.loaded_count = 0;
+        for slot in 0..self.set_count {
+            let force = self.slot_forces[slot];
+            if force != 0.0 {
+                self.loaded_nodes[self.loaded_count] = self.set_nodes[slot];
+                self.loaded_forces_n[self.loaded_count] = force;
+                self.loaded_count += 1;
+            }
+        }
+        for node in 0..n {
+            self.node_corrections_m[node] = if self.node_slots[node] != UNSET {
+                self.node_steps_m[node] - self.node_free_steps_m[node]
+            } else {
+                0.0
+            };
+        }
+        self.update_tracking(band_m, release_m);
+        NodalOutcome {
+            iterations,
+            converged,
+            damping_loss_j,
+            penetration_m,
+            force_change_n,
+        }
+    }
+
+    /// Tracked points farther than `release_m` from contact with no force now and none at rest
+    /// leave; untracked points within `band_m` join.
+    fn update_tracking(&mut self, band_m: f64, release_m: f64) {
+        let mut t = 0;
+        while t < self.tracked_count {
+            let i = self.tracked[t];
+            let far = self.gaps_m[i] < -release_m
+                && self.point_forces[i] == 0.0
+                && self.rest_forces_n[i] == 0.0;
+            if far {
+                self.tracked_count -= 1;
+                self.tracked[t] = self.tracked[self.tracked_count];
+                self.far_offsets_m[i] = 0.0;
+                self.set_changed = true;
+            } else {
+                t += 1;
+            }
+        }
+        if self.far_point_near {
+            for i in 0..self.point_count {
+                if self.far_offsets_m[i] == 0.0 && self.gaps_m[i] > -band_m {
+                    self.far_offsets_m[i] = f64::NEG_INFINITY;
+                    self.tracked[self.tracked_count] = i;
+                    self.tracked_count += 1;
+                    self.point_forces[i] = 0.0;
+                    self.cases[i] = OUT;
+                }
+            }
+            self.set_changed = true;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The branch-free law is `contact.rs`'s mid-point force with the linearly implicit damping
+    /// in each of its four cases (staying in, leaving, entering, staying out), force and
+    /// stiffness, to round-off; and it names the case.
+    #[test]
+    fn the_lane_law_is_the_contact_law() {
+        let law = HuntCrossley {
+            xi: 1.3e3,
+            psi: 40.0,
+        };
+        for (gap, step, case) in [
+            (2e-6, 0.5e-6, IN),
+            (2e-6, -3e-6, IN),
+            (1e-6, 3e-6, CROSSING),
+            (-1e-6, -2.5e-6, CROSSING),
+            (-1e-6, 0.5e-6, OUT),
+            (-1e-6, 0.0, OUT),
+        ] {
+            let expected = law.midpoint_force_linear_damping(gap, step);
+            let (force, stiffness, named) = law_lane(gap, step, law.xi, law.psi);
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-30);
+            assert!(
+                close(force, expected.force),
+                "{gap} {step}: {force} {}",
+                expected.force
+            );
+            assert!(
+                close(stiffness, expected.stiffness),
+                "{gap} {step}: {stiffness} {}",
+                expected.stiffness
+            );
+            assert_eq!(named, case, "{gap} {step}");
+        }
+    }
+}
