@@ -3,7 +3,8 @@
 //! `cargo run --release -p javari-core --example grid_mode_cost -- [KEY] [BRIDGE/THREAD] [nodes|points]`
 //! (defaults: key 60, contact points every 0.18 / 0.15 mm as the reference's barrier grids, the
 //! contact condensed on the grid's nodes). Prints the real-time factor of three runs of 3 s,
-//! Newton's updates per step and a checksum of the nut force, so that the condensed and the
+//! Newton's updates per step, a checksum of the nut force and what one of the voice's tuning
+//! passes costs (a new tension and the linearised fundamental), so that the condensed and the
 //! point-level solves can be compared for cost and for the same string. A timing loop for
 //! profiling; the bench is the figure of record.
 
@@ -57,9 +58,21 @@ fn main() {
             checksum += string.nut_force_change_n().abs();
         }
         let factor = SECONDS / start.elapsed().as_secs_f64();
+        // A retune of the ringing string: a new configuration (the tension 0.1 % up or down,
+        // alternately) and its linearised fundamental, as each of the voice's tuning passes.
+        let retunes = 20;
+        let start = Instant::now();
+        for retune in 0..retunes {
+            let mut changed = config;
+            changed.string.tension_n *= if retune % 2 == 0 { 1.001 } else { 1.0 };
+            string.set_config(changed);
+            string.linearised_fundamental_hz();
+        }
+        let retune_us = start.elapsed().as_secs_f64() / retunes as f64 * 1e6;
         println!(
             "run {run}: key {key}, {} points, {} nodes: {factor:.2}x real time, Newton {:.3} \
-             updates per step, checksum {checksum:.9e}",
+             updates per step, checksum {checksum:.9e}; a tuning pass (new tension, linearised \
+             fundamental) {retune_us:.0} µs",
             string.point_positions_m().len(),
             string.contact_node_count(),
             string.newton_stats().mean_iterations()

@@ -457,15 +457,30 @@ impl<T: Real> ModalString<T> {
     /// (section 11); the point-level solve otherwise, or when the points reach more than
     /// [`NODE_CAPACITY`] nodes.
     fn configure_nodes(&mut self) {
-        self.nodal_in_use = match self.config.grid_modes {
-            Some(grid) if grid.condensed => self.nodal.configure(
-                &self.points,
-                &self.modes,
-                grid.intervals,
-                self.config.string.length_m,
+        let (in_use, condensed) = match self.config.grid_modes {
+            Some(grid) if grid.condensed => (
+                self.nodal.configure(
+                    &self.points,
+                    &self.modes,
+                    grid.intervals,
+                    self.config.string.length_m,
+                ),
+                true,
             ),
-            _ => false,
+            _ => (false, false),
         };
+        self.nodal_in_use = in_use;
+        if condensed && !in_use {
+            // More nodes than the condensed solve holds: the point-level solve, which needs the
+            // coupling on the points that the condensed placement left out.
+            self.points.couple_from(
+                0,
+                &self.modes,
+                self.config.static_flexibility,
+                &self.kernels,
+                true,
+            );
+        }
         if self.nodal_in_use {
             for (target, source) in self.node_shapes.iter_mut().zip(&self.nodal.node_shapes) {
                 *target = T::from_f64(*source);
@@ -603,11 +618,13 @@ impl<T: Real> ModalString<T> {
     /// Couples the points `first..` to the modes (those before unchanged since they were).
     fn couple_points_from(&mut self, first: usize) {
         // From 0 with residual modes (`ContactPoints::couple_from`).
+        let condensed = matches!(self.config.grid_modes, Some(grid) if grid.condensed);
         let first = self.points.couple_from(
             first,
             &self.modes,
             self.config.static_flexibility,
             &self.kernels,
+            !condensed,
         );
         let rows = first * MODE_CAPACITY..;
         for (target, source) in self.shapes[rows.clone()]

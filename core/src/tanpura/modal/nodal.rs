@@ -523,7 +523,7 @@ impl NodalContact {
     }
 
     /// Every tracked point's step, force, c and case at the iterate on S, in chunks of
-    /// [`LANES`]; the nodal force change on S and each segment's `Σ c w wᵀ`. Returns whether a
+    /// [`LANES`], and the nodal force change on S. Returns whether a
     /// point's case changed since the last evaluation, and whether a point crosses.
     #[inline(always)]
     fn evaluate(&mut self) -> (bool, bool) {
@@ -570,16 +570,36 @@ impl NodalContact {
                 }
                 start += LANES;
             }
-            // The nodal force change and Σ c w wᵀ over the points that carry a force or a
-            // stiffness.
+            // The nodal force change over the points whose force left its rest value.
             let mut force_sums = [0.0; 4];
-            let mut stiffness_sums = [0.0; 10];
             for i in segment.start..segment.end {
-                let (change, stiffness) = (
-                    self.point_forces[i] - self.rest_forces_n[i],
-                    self.point_stiffnesses[i],
-                );
-                if change == 0.0 && stiffness == 0.0 {
+                let change = self.point_forces[i] - self.rest_forces_n[i];
+                if change == 0.0 {
+                    continue;
+                }
+                for (sum, column) in force_sums.iter_mut().zip(&self.weight_columns) {
+                    *sum += column[i] * change;
+                }
+            }
+            for (slot, sum) in segment.slots.iter().zip(force_sums) {
+                self.slot_forces[*slot] += sum;
+            }
+        }
+        (changed, crossing)
+    }
+
+    /// Each segment's `Σ c w_j w_l` over [`PAIRS`] at the last evaluation (only before an
+    /// update: the evaluation that ends the iteration needs none), over the points with c > 0.
+    #[inline(always)]
+    fn sum_stiffnesses(&mut self) {
+        for (segment, total) in self.segments[..self.segment_count]
+            .iter()
+            .zip(&mut self.segment_stiffness)
+        {
+            let mut sums = [0.0; 10];
+            for i in segment.start..segment.end {
+                let stiffness = self.point_stiffnesses[i];
+                if stiffness == 0.0 {
                     continue;
                 }
                 let weights = [
@@ -588,19 +608,12 @@ impl NodalContact {
                     self.weight_columns[2][i],
                     self.weight_columns[3][i],
                 ];
-                for (sum, weight) in force_sums.iter_mut().zip(&weights) {
-                    *sum += weight * change;
-                }
-                for (sum, &(j, k)) in stiffness_sums.iter_mut().zip(&PAIRS) {
+                for (sum, &(j, k)) in sums.iter_mut().zip(&PAIRS) {
                     *sum += stiffness * weights[j] * weights[k];
                 }
             }
-            for (slot, sum) in segment.slots.iter().zip(force_sums) {
-                self.slot_forces[*slot] += sum;
-            }
-            self.segment_stiffness[index] = stiffness_sums;
+            *total = sums;
         }
-        (changed, crossing)
     }
 
     /// Newton's iteration on S from the iterate in `slot_steps`. Returns (updates, converged).
@@ -635,6 +648,7 @@ impl NodalContact {
             if updates >= settings.max_iterations {
                 return (updates, false);
             }
+            self.sum_stiffnesses();
             let mut steps = [0.0; N];
             steps[..m].copy_from_slice(&self.slot_steps[..m]);
             let mut forces = [0.0; N];
@@ -680,6 +694,7 @@ impl NodalContact {
             if updates >= settings.max_iterations {
                 return (updates, false);
             }
+            self.sum_stiffnesses();
             // (H + Σ c l lᵀ) δ = f − H (Δy − Δy_free), its lower triangle, stride m.
             for a in 0..m {
                 let mut rhs = self.slot_forces[a];
