@@ -12,15 +12,17 @@
 //! without two residual modes, at the output rate and at four times it, over the whole grid
 //! against the refined string and against the reference (both tuned by linearisation; about
 //! five minutes on two cores); `-- --grid-modes` the same with every mode of the reference's FD
-//! grid instead of the continuous string's (§10). `cargo xtask bench` measures the same without
-//! the residual modes, and caches the refined renders.
+//! grid instead of the continuous string's (§10); `-- --grid-spacings` the grid modes with the
+//! contact condensed on the nodes (§11) and contact points from the reference's spacing to the
+//! tier's. `cargo xtask bench` measures the same without the residual modes, and caches the
+//! refined renders.
 //!
 //! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
 //! tier tuned by linearising about its own rest state (no calibration as played), so that the
 //! schemes are compared at equal physical parameters; the refined string is tuned and plucked
 //! the same way. The four measures are the bench's (`analysis::listening::compare`). The figures
 //! are quoted in `docs/modal-tanpura.md`, section 9 ("Stop 35"; `--rate-grid`: "Stop 40";
-//! `--grid-modes`: section 10).
+//! `--grid-modes`: section 10; `--grid-spacings`: section 11).
 
 use javari_core::analysis::listening::{compare, ListeningDifference};
 use javari_core::analysis::playing_range::{full_grid, GridPoint, CREST_KEYS};

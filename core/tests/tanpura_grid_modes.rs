@@ -1,6 +1,7 @@
 //! The modal string with the reference's FD grid as its modes (`ModalStringConfig::grid_modes`,
 //! `docs/modal-tanpura.md` §10): every mode of the grid is kept, so the static problems see the
-//! grid's whole compliance and the string must rest where the FD string rests. (Its energy
+//! grid's whole compliance and the string must rest where the FD string rests; and its contact
+//! condensed on the grid's nodes (§11) must play what the point-level solve plays. (Its energy
 //! balance is checked with the other modal strings' in `tanpura_modal.rs`, its free partials
 //! beside the FD's in `tanpura_invariants.rs`.)
 

@@ -4,7 +4,7 @@
 //! grid's nodes (the seed's eq. 17), so its shape row factors: `Ψ_i = L_i V`, with `L_i` the
 //! point's four stencil weights and `V` the scaled sampled sines on the nodes the stencils reach
 //! (`V_jk = sin(kπ n_j/N)/√κ_k`). Everything the step needs from the modes then passes through
-//! those few nodes (about 16 for the seed's bridge and thread, against 170 points at the
+//! those few nodes (11 for the seed's bridge and thread, against 170 points at the
 //! reference's spacing):
 //!
 //! - the nodes' free step `Δy_free = V s_free` (one dot product per node), and every point's
@@ -31,7 +31,10 @@
 //! **Which points Newton sees.** Those within the tracking band of contact, or loaded at rest,
 //! as in section 4. After Newton every point's step is formed from the nodes in one pass over
 //! runs of points that share a stencil (plain arrays the compiler vectorises); if an untracked
-//! point would touch, it joins and the solve is redone before anything moves.
+//! point would touch, it joins and the solve is redone before anything moves. The tracked points
+//! are evaluated in chunks of [`LANES`] with a branch-free copy of the contact law; H is formed
+//! again only when the node set S changes, not with every point that joins or leaves; up to 8
+//! and 16 nodes the update is solved in fixed lanes.
 //!
 //! Hand-written rather than on a linear-algebra crate: the systems have at most
 //! [`NODE_CAPACITY`] unknowns and are solved once or twice per sample on the audio thread;
