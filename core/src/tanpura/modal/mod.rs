@@ -507,7 +507,15 @@ impl<T: Real> ModalString<T> {
     fn place_thread_lattice(&mut self) {
         let configured_m = self.config.thread_point_spacing_m;
         let mut best = (f64::NEG_INFINITY, configured_m, 0.0);
-        for (tried, lattice) in THREAD_LATTICES.into_iter().enumerate() {
+        // On grid modes, the configured lattice alone (section 11: with the contact condensed
+        // on the nodes a point at the contact's edge costs a lane, not a row of the solve; the
+        // point-level solve takes the same points, so that the two solve the same string).
+        let tried_lattices = if self.config.grid_modes.is_some() {
+            1
+        } else {
+            THREAD_LATTICES.len()
+        };
+        for (tried, lattice) in THREAD_LATTICES[..tried_lattices].iter().enumerate() {
             let spacing_m = lattice.spacing * configured_m;
             let offset_m = lattice.offset * spacing_m;
             if tried == 0 {

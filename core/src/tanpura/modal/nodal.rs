@@ -373,9 +373,16 @@ impl NodalContact {
         for (j, &node) in self.grid_nodes[..node_count].iter().enumerate() {
             let row = &mut self.node_shapes[j * MODE_CAPACITY..(j + 1) * MODE_CAPACITY];
             row.fill(0.0);
-            for (k, value) in row[..modes_count].iter_mut().enumerate() {
-                let angle = (k + 1) as f64 * PI * node as f64 / intervals as f64;
-                *value = angle.sin() * modes.inverse_root_stiffness[k];
+            // sin(kθ), θ = π n/N, by the recurrence sin((k+1)θ) = 2 cos θ sin(kθ) − sin((k−1)θ).
+            let theta = PI * node as f64 / intervals as f64;
+            let twice_cos = 2.0 * theta.cos();
+            let (mut previous, mut current) = (0.0, theta.sin());
+            for (value, scale) in row[..modes_count]
+                .iter_mut()
+                .zip(&modes.inverse_root_stiffness)
+            {
+                *value = current * scale;
+                (previous, current) = (current, twice_cos * current - previous);
             }
         }
         for j in 0..node_count {
