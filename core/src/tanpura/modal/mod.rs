@@ -833,22 +833,43 @@ impl<T: Real> ModalString<T> {
             // Contact damping at this step's forces; the modes' loss needs the whole step below.
             self.cumulative_losses_j += outcome.damping_loss_j;
         }
-        let penetration = outcome.penetration_m;
-
-        let (loaded, changes) = self.contact.loaded();
+        let (_, changes) = self.contact.loaded();
         let mut bridge_change = 0.0;
         for (value, change) in self.loaded_forces.iter_mut().zip(changes) {
             *value = T::from_f64(*change);
             bridge_change += change;
         }
+        self.advance_and_finish(simd, false, bridge_change, outcome.penetration_m);
+    }
+
+    /// The end of a step: the modes advanced by eq. M1 with the force changes of the solve in
+    /// use on their shape rows (the nodes' with `on_nodes`, section 11; else the loaded points'),
+    /// the modes' loss booked, and the outputs set; a non-finite state cannot recover, so it
+    /// silences the string at rest (fail soft).
+    #[inline(always)]
+    fn advance_and_finish<S: Simd>(
+        &mut self,
+        simd: S,
+        on_nodes: bool,
+        bridge_change: f64,
+        penetration_m: f64,
+    ) {
+        let lanes = self.lanes;
+        let (rows, forces, matrix) = if on_nodes {
+            let rows = self.nodal.loaded().0;
+            (rows, &self.node_forces[..rows.len()], &self.node_shapes[..])
+        } else {
+            let rows = self.contact.loaded().0;
+            (rows, &self.loaded_forces[..rows.len()], &self.shapes[..])
+        };
         let nut_change = AdvanceAndPrepare {
             a: &self.a[..lanes],
             b: &self.b[..lanes],
             c: &self.nut_weights[..lanes],
-            matrix: &self.shapes,
+            matrix,
             stride: MODE_CAPACITY,
-            rows: loaded,
-            forces: &self.loaded_forces[..loaded.len()],
+            rows,
+            forces,
             work: &mut self.whole_step[..lanes],
             s: &mut self.step[..lanes],
             r: &mut self.modal[..lanes],
@@ -865,9 +886,8 @@ impl<T: Real> ModalString<T> {
         }
         self.nut_force_change_n = nut_change;
         self.bridge_force_change_n = bridge_change;
-        self.max_penetration_m = penetration;
+        self.max_penetration_m = penetration_m;
         if !nut_change.is_finite() || !bridge_change.is_finite() {
-            // Fail soft: a non-finite state cannot recover, so silence the string at rest.
             self.non_finite_resets += 1;
             let external = self.external_work_j;
             self.settle_to_rest();
@@ -898,42 +918,11 @@ impl<T: Real> ModalString<T> {
         if self.config.track_energy {
             self.cumulative_losses_j += outcome.damping_loss_j;
         }
-        let (loaded, changes) = self.nodal.loaded();
+        let (_, changes) = self.nodal.loaded();
         for (value, change) in self.node_forces.iter_mut().zip(changes) {
             *value = T::from_f64(*change);
         }
-        let nut_change = AdvanceAndPrepare {
-            a: &self.a[..lanes],
-            b: &self.b[..lanes],
-            c: &self.nut_weights[..lanes],
-            matrix: &self.node_shapes,
-            stride: MODE_CAPACITY,
-            rows: loaded,
-            forces: &self.node_forces[..loaded.len()],
-            work: &mut self.whole_step[..lanes],
-            s: &mut self.step[..lanes],
-            r: &mut self.modal[..lanes],
-            p: &mut self.velocity[..lanes],
-        }
-        .with_simd(simd);
-        if self.config.track_energy {
-            self.cumulative_losses_j += (0..self.modes.count())
-                .map(|k| {
-                    let s = self.whole_step[k].to_f64();
-                    self.modes.loss_factor[k] * s * s
-                })
-                .sum::<f64>();
-        }
-        let bridge_change = outcome.force_change_n;
-        self.nut_force_change_n = nut_change;
-        self.bridge_force_change_n = bridge_change;
-        self.max_penetration_m = outcome.penetration_m;
-        if !nut_change.is_finite() || !bridge_change.is_finite() {
-            self.non_finite_resets += 1;
-            let external = self.external_work_j;
-            self.settle_to_rest();
-            self.external_work_j = external;
-        }
+        self.advance_and_finish(simd, true, outcome.force_change_n, outcome.penetration_m);
     }
 
     /// Puts to sleep the far points that the string's vibration energy cannot carry into

@@ -76,20 +76,30 @@ const PAIRS: [(usize, usize); 10] = [
     (3, 3),
 ];
 
-/// Consecutive points whose stencils reach the same four nodes.
+/// Consecutive points `start..end` whose stencils reach the same four places: a run of points
+/// (the places are local nodes) or a segment of tracked points (the places are slots in S).
 #[derive(Debug, Clone, Copy, Default)]
-struct Run {
+struct Span {
     start: usize,
     end: usize,
-    nodes: [usize; 4],
+    places: [usize; 4],
 }
 
-/// Consecutive tracked points of one run, with their stencil's slots in S.
-#[derive(Debug, Clone, Copy, Default)]
-struct Segment {
-    start: usize,
-    end: usize,
-    slots: [usize; 4],
+/// Appends point `i`, whose stencil reaches `places`, to the spans `spans[..*count]`: it extends
+/// the last span if it follows it with the same places, else it opens a new one.
+fn append_to_spans(spans: &mut [Span], count: &mut usize, i: usize, places: [usize; 4]) {
+    if let Some(last) = spans[..*count].last_mut() {
+        if last.end == i && last.places == places {
+            last.end = i + 1;
+            return;
+        }
+    }
+    spans[*count] = Span {
+        start: i,
+        end: i + 1,
+        places,
+    };
+    *count += 1;
 }
 
 /// What one step's contact work reports.
@@ -120,7 +130,7 @@ pub struct NodalContact {
     /// the stencil's nearest interior node); its weights by column.
     stencil_nodes: Vec<[usize; 4]>,
     weight_columns: [Vec<f64>; 4],
-    runs: Vec<Run>,
+    runs: Vec<Span>,
     run_count: usize,
     /// Per point: the law's ξ and ψ, and the rest force, N.
     xis: Vec<f64>,
@@ -146,7 +156,7 @@ pub struct NodalContact {
     inverse: Vec<f64>,
     /// The tracked points in segments, and each segment's `Σ c w_j w_l` over [`PAIRS`] at the
     /// last evaluation.
-    segments: Vec<Segment>,
+    segments: Vec<Span>,
     segment_count: usize,
     segment_stiffness: Vec<[f64; 10]>,
     /// Per slot: the free step, the iterate and the nodal force change.
@@ -248,7 +258,7 @@ impl NodalContact {
             point_count: 0,
             stencil_nodes: vec![[0; 4]; capacity],
             weight_columns: std::array::from_fn(|_| zeros(padded)),
-            runs: vec![Run::default(); capacity],
+            runs: vec![Span::default(); capacity],
             run_count: 0,
             xis: zeros(padded),
             psis: zeros(padded),
@@ -264,7 +274,7 @@ impl NodalContact {
             set_nodes: vec![0; NODE_CAPACITY],
             node_slots: vec![UNSET; NODE_CAPACITY],
             inverse: zeros(NODE_CAPACITY * NODE_CAPACITY),
-            segments: vec![Segment::default(); capacity],
+            segments: vec![Span::default(); capacity],
             segment_count: 0,
             segment_stiffness: vec![[0.0; 10]; capacity],
             slot_free: zeros(NODE_CAPACITY),
@@ -356,17 +366,12 @@ impl NodalContact {
         }
         self.run_count = 0;
         for i in 0..count {
-            let nodes = self.stencil_nodes[i];
-            if self.run_count > 0 && self.runs[self.run_count - 1].nodes == nodes {
-                self.runs[self.run_count - 1].end = i + 1;
-            } else {
-                self.runs[self.run_count] = Run {
-                    start: i,
-                    end: i + 1,
-                    nodes,
-                };
-                self.run_count += 1;
-            }
+            append_to_spans(
+                &mut self.runs,
+                &mut self.run_count,
+                i,
+                self.stencil_nodes[i],
+            );
         }
         // V and G_N = V diag(b) Vᵀ.
         let modes_count = modes.count();
@@ -468,20 +473,7 @@ impl NodalContact {
         for t in 0..self.tracked_count {
             let i = self.tracked[t];
             let slots = self.stencil_nodes[i].map(|node| self.node_slots[node]);
-            let extends = self.segment_count > 0 && {
-                let last = &self.segments[self.segment_count - 1];
-                last.end == i && last.slots == slots
-            };
-            if extends {
-                self.segments[self.segment_count - 1].end = i + 1;
-            } else {
-                self.segments[self.segment_count] = Segment {
-                    start: i,
-                    end: i + 1,
-                    slots,
-                };
-                self.segment_count += 1;
-            }
+            append_to_spans(&mut self.segments, &mut self.segment_count, i, slots);
         }
         self.set_changed = false;
         if new_set {
@@ -541,7 +533,7 @@ impl NodalContact {
         let (mut changed, mut crossing) = (false, false);
         for index in 0..self.segment_count {
             let segment = self.segments[index];
-            let y = segment.slots.map(|slot| self.slot_steps[slot]);
+            let y = segment.places.map(|slot| self.slot_steps[slot]);
             let mut start = segment.start;
             while start < segment.end {
                 let valid = (segment.end - start).min(LANES);
@@ -591,7 +583,7 @@ impl NodalContact {
                     *sum += column[i] * change;
                 }
             }
-            for (slot, sum) in segment.slots.iter().zip(force_sums) {
+            for (slot, sum) in segment.places.iter().zip(force_sums) {
                 self.slot_forces[*slot] += sum;
             }
         }
@@ -676,7 +668,7 @@ impl NodalContact {
                 .zip(&self.segment_stiffness)
             {
                 for (&(j, k), &value) in PAIRS.iter().zip(sums) {
-                    let (a, b) = (segment.slots[j], segment.slots[k]);
+                    let (a, b) = (segment.places[j], segment.places[k]);
                     matrix[a.max(b)][a.min(b)] += value;
                 }
             }
@@ -720,7 +712,7 @@ impl NodalContact {
                 .zip(&self.segment_stiffness)
             {
                 for (&(j, k), &value) in PAIRS.iter().zip(sums) {
-                    let (a, b) = (segment.slots[j], segment.slots[k]);
+                    let (a, b) = (segment.places[j], segment.places[k]);
                     self.matrix[a.max(b) * m + a.min(b)] += value;
                 }
             }
@@ -793,7 +785,7 @@ impl NodalContact {
             // whether one then lies within the band.
             let (mut touches, mut near) = (false, false);
             for run in &self.runs[..self.run_count] {
-                let y = run.nodes.map(|node| self.node_steps_m[node]);
+                let y = run.places.map(|node| self.node_steps_m[node]);
                 let range = run.start..run.end;
                 let columns = [
                     &self.weight_columns[0][range.clone()],
