@@ -182,6 +182,9 @@ pub struct NodalContact {
     loaded_count: usize,
     /// Whether an untracked point lies within the tracking band after the step.
     far_point_near: bool,
+    /// Whether every update takes the general path (for the test that the paths agree).
+    #[cfg(test)]
+    general_path_only: bool,
 }
 
 /// The mid-point force of `contact.rs` (`HuntCrossley::midpoint_force_linear_damping`) for a
@@ -294,7 +297,15 @@ impl NodalContact {
             loaded_forces_n: zeros(NODE_CAPACITY),
             loaded_count: 0,
             far_point_near: false,
+            #[cfg(test)]
+            general_path_only: false,
         }
+    }
+
+    /// Makes every update take the general path (the test that the paths agree).
+    #[cfg(test)]
+    pub(super) fn take_general_path_only(&mut self) {
+        self.general_path_only = true;
     }
 
     /// How many nodes the points reach (0: not configured).
@@ -619,66 +630,28 @@ impl NodalContact {
     }
 
     /// Newton's iteration on S from the iterate in `slot_steps`. Returns (updates, converged).
-    /// Up to 8 and up to 16 nodes (every step of the bench's scenes) the system is solved in
-    /// fixed lanes, padded with the identity; the general path takes more.
     #[inline(always)]
     fn newton(&mut self, settings: &NewtonSettings) -> (u32, bool) {
-        match self.set_count {
-            0..=8 => self.newton_in_lanes::<8>(settings),
-            9..=16 => self.newton_in_lanes::<16>(settings),
-            _ => self.newton_general(settings),
-        }
-    }
-
-    /// [`NodalContact::newton`] in `N ≥ |S|` fixed lanes: the same updates.
-    #[inline(always)]
-    fn newton_in_lanes<const N: usize>(&mut self, settings: &NewtonSettings) -> (u32, bool) {
-        let m = self.set_count;
-        let mut inverse = [[0.0; N]; N];
-        for (a, row) in inverse.iter_mut().enumerate() {
-            if a < m {
-                row[..m].copy_from_slice(&self.inverse[a * NODE_CAPACITY..a * NODE_CAPACITY + m]);
+        self.evaluate();
+        let mut updates = 0;
+        loop {
+            if updates >= settings.max_iterations {
+                return (updates, false);
+            }
+            self.sum_stiffnesses();
+            #[cfg(test)]
+            let size = if self.general_path_only {
+                usize::MAX
             } else {
-                row[a] = 1.0;
-            }
-        }
-        let mut free = [0.0; N];
-        free[..m].copy_from_slice(&self.slot_free[..m]);
-        self.evaluate();
-        let mut updates = 0;
-        loop {
-            if updates >= settings.max_iterations {
-                return (updates, false);
-            }
-            self.sum_stiffnesses();
-            let mut steps = [0.0; N];
-            steps[..m].copy_from_slice(&self.slot_steps[..m]);
-            let mut forces = [0.0; N];
-            forces[..m].copy_from_slice(&self.slot_forces[..m]);
-            // (H + Σ c l lᵀ) δ = f − H (Δy − Δy_free); the padding solves δ = 0.
-            let mut matrix = inverse;
-            let mut delta = forces;
-            for (value, row) in delta.iter_mut().zip(&inverse) {
-                for b in 0..N {
-                    *value -= row[b] * (steps[b] - free[b]);
-                }
-            }
-            for (segment, sums) in self.segments[..self.segment_count]
-                .iter()
-                .zip(&self.segment_stiffness)
-            {
-                for (&(j, k), &value) in PAIRS.iter().zip(sums) {
-                    let (a, b) = (segment.places[j], segment.places[k]);
-                    matrix[a.max(b)][a.min(b)] += value;
-                }
-            }
-            ldl_factor_fixed(&mut matrix);
-            ldl_substitute_fixed(&matrix, &mut delta);
-            let mut largest = 0.0f64;
-            for (step, &change) in self.slot_steps[..m].iter_mut().zip(&delta) {
-                *step += change;
-                largest = largest.max(change.abs());
-            }
+                self.set_count
+            };
+            #[cfg(not(test))]
+            let size = self.set_count;
+            let largest = match size {
+                0..=8 => self.update_in_lanes::<8>(),
+                9..=16 => self.update_in_lanes::<16>(),
+                _ => self.update_general(),
+            };
             updates += 1;
             let (changed, crossing) = self.evaluate();
             if !(changed || crossing) || largest <= settings.tolerance_m {
@@ -687,52 +660,83 @@ impl NodalContact {
         }
     }
 
-    /// [`NodalContact::newton`] on any number of nodes.
-    fn newton_general(&mut self, settings: &NewtonSettings) -> (u32, bool) {
+    /// One update (N1), `(H + Σ c l lᵀ) δ = f − H (Δy − Δy_free)`, applied to the iterate, in
+    /// `N ≥ |S|` fixed lanes padded with the identity (the padding solves δ = 0). Up to 8 and up
+    /// to 16 nodes (every step of the bench's scenes). Returns max|δ|.
+    #[inline(always)]
+    fn update_in_lanes<const N: usize>(&mut self) -> f64 {
         let m = self.set_count;
-        self.evaluate();
-        let mut updates = 0;
-        loop {
-            if updates >= settings.max_iterations {
-                return (updates, false);
+        let mut matrix = [[0.0; N]; N];
+        let mut delta = [0.0; N];
+        for (a, row) in matrix.iter_mut().enumerate() {
+            if a >= m {
+                row[a] = 1.0;
+                continue;
             }
-            self.sum_stiffnesses();
-            // (H + Σ c l lᵀ) δ = f − H (Δy − Δy_free), its lower triangle, stride m.
-            for a in 0..m {
-                let mut rhs = self.slot_forces[a];
-                for b in 0..m {
-                    let h = self.inverse[a * NODE_CAPACITY + b];
-                    rhs -= h * (self.slot_steps[b] - self.slot_free[b]);
-                    self.matrix[a * m + b] = h;
-                }
-                self.right_side[a] = rhs;
-            }
-            for (segment, sums) in self.segments[..self.segment_count]
-                .iter()
-                .zip(&self.segment_stiffness)
-            {
-                for (&(j, k), &value) in PAIRS.iter().zip(sums) {
-                    let (a, b) = (segment.places[j], segment.places[k]);
-                    self.matrix[a.max(b) * m + a.min(b)] += value;
-                }
-            }
-            ldl_solve_in_place(
-                &mut self.matrix[..m * m],
-                m,
-                &mut self.right_side[..m],
-                &mut self.scratch[..m],
-            );
-            let mut largest = 0.0f64;
-            for (step, &delta) in self.slot_steps[..m].iter_mut().zip(&self.right_side[..m]) {
-                *step += delta;
-                largest = largest.max(delta.abs());
-            }
-            updates += 1;
-            let (changed, crossing) = self.evaluate();
-            if !(changed || crossing) || largest <= settings.tolerance_m {
-                return (updates, true);
+            let inverse = &self.inverse[a * NODE_CAPACITY..a * NODE_CAPACITY + m];
+            row[..m].copy_from_slice(inverse);
+            delta[a] = self.slot_forces[a];
+            for (b, &h) in inverse.iter().enumerate() {
+                delta[a] -= h * (self.slot_steps[b] - self.slot_free[b]);
             }
         }
+        self.add_stiffnesses(|a, b, value| matrix[a][b] += value);
+        ldl_factor_fixed(&mut matrix);
+        ldl_substitute_fixed(&matrix, &mut delta);
+        self.apply_update(&delta[..m])
+    }
+
+    /// [`NodalContact::update_in_lanes`] on any number of nodes (stride m, lower triangle).
+    fn update_general(&mut self) -> f64 {
+        let m = self.set_count;
+        for a in 0..m {
+            let mut rhs = self.slot_forces[a];
+            for b in 0..m {
+                let h = self.inverse[a * NODE_CAPACITY + b];
+                rhs -= h * (self.slot_steps[b] - self.slot_free[b]);
+                self.matrix[a * m + b] = h;
+            }
+            self.right_side[a] = rhs;
+        }
+        let mut matrix = std::mem::take(&mut self.matrix);
+        self.add_stiffnesses(|a, b, value| matrix[a * m + b] += value);
+        self.matrix = matrix;
+        ldl_solve_in_place(
+            &mut self.matrix[..m * m],
+            m,
+            &mut self.right_side[..m],
+            &mut self.scratch[..m],
+        );
+        let delta = std::mem::take(&mut self.right_side);
+        let largest = self.apply_update(&delta[..m]);
+        self.right_side = delta;
+        largest
+    }
+
+    /// Calls `add(a, b, value)` with each segment's `Σ c w_j w_l` at its slots, a ≥ b (the lower
+    /// triangle the LDLᵀ solvers read).
+    #[inline(always)]
+    fn add_stiffnesses(&self, mut add: impl FnMut(usize, usize, f64)) {
+        for (segment, sums) in self.segments[..self.segment_count]
+            .iter()
+            .zip(&self.segment_stiffness)
+        {
+            for (&(j, k), &value) in PAIRS.iter().zip(sums) {
+                let (a, b) = (segment.places[j], segment.places[k]);
+                add(a.max(b), a.min(b), value);
+            }
+        }
+    }
+
+    /// Adds `delta` to the iterate on S; returns max|δ|.
+    #[inline(always)]
+    fn apply_update(&mut self, delta: &[f64]) -> f64 {
+        let mut largest = 0.0f64;
+        for (step, &change) in self.slot_steps.iter_mut().zip(delta) {
+            *step += change;
+            largest = largest.max(change.abs());
+        }
+        largest
     }
 
     /// One step's contact with the nodes' free steps in `node_free_steps_m`: Newton on S, then
