@@ -313,11 +313,6 @@ impl NodalContact {
         self.node_count
     }
 
-    /// The tracked points.
-    pub fn tracked_count(&self) -> usize {
-        self.tracked_count
-    }
-
     /// The nodes with a non-zero force change after the last step and the changes, N: what
     /// the modes feel, through the node rows.
     pub fn loaded(&self) -> (&[usize], &[f64]) {
