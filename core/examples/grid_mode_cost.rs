@@ -4,7 +4,8 @@
 //! (defaults: key 60, contact points every 0.18 / 0.15 mm as the reference's barrier grids, the
 //! contact condensed on the grid's nodes). Prints the real-time factor of three runs of 3 s,
 //! Newton's updates per step, a checksum of the nut force and what one of the voice's tuning
-//! passes costs (a new tension and the linearised fundamental), so that the condensed and the
+//! passes costs (a new tension and the linearised fundamental) and a pluck of the ringing string,
+//! with the linearised fundamental, so that the condensed and the
 //! point-level solves can be compared for cost and for the same string. A timing loop for
 //! profiling; the bench is the figure of record.
 
@@ -69,13 +70,22 @@ fn main() {
             string.linearised_fundamental_hz();
         }
         let retune_us = start.elapsed().as_secs_f64() / retunes as f64 * 1e6;
+        // Plucks of the ringing string (the finger's press solved with the contact).
+        let start = Instant::now();
+        for _ in 0..retunes {
+            string.pluck(&Pluck::default());
+        }
+        let pluck_us = start.elapsed().as_secs_f64() / retunes as f64 * 1e6;
+        string.set_config(config);
         println!(
             "run {run}: key {key}, {} points, {} nodes: {factor:.2}x real time, Newton {:.3} \
              updates per step, checksum {checksum:.9e}; a tuning pass (new tension, linearised \
-             fundamental) {retune_us:.0} µs",
+             fundamental) {retune_us:.0} µs, a pluck {pluck_us:.0} µs; linearised fundamental \
+             {:.9} Hz",
             string.point_positions_m().len(),
             string.contact_node_count(),
-            string.newton_stats().mean_iterations()
+            string.newton_stats().mean_iterations(),
+            string.linearised_fundamental_hz()
         );
     }
 }

@@ -37,6 +37,7 @@ mod block;
 pub mod lanes;
 pub mod modes;
 pub mod nodal;
+pub mod nodal_statics;
 pub mod points;
 pub mod solve;
 pub mod step;
@@ -51,6 +52,7 @@ use lanes::{padded_lanes, AdvanceAndPrepare, Dots, Kernels, LeadingDots, Real, L
 pub use modes::GridModes;
 use modes::{ModeSet, AUDIBLE_LIMIT_HZ, MODE_CAPACITY};
 use nodal::{NodalContact, NODE_CAPACITY};
+use nodal_statics::NodalStatics;
 use points::{grid_points, ContactPoints};
 use pulp::{Simd, WithSimd};
 use solve::{linearised_fundamental, StaticSolver};
@@ -300,6 +302,8 @@ pub struct ModalString<T: Real> {
     node_shapes: CacheAligned<T>,
     node_forces: Vec<T>,
     solver: StaticSolver,
+    /// The static problems on the nodes, with the condensed contact (`nodal_statics.rs`).
+    statics: NodalStatics,
     loaded_forces: Vec<T>,
     /// r_rest (f64) and a scratch row.
     rest_modal: Vec<f64>,
@@ -348,6 +352,7 @@ impl<T: Real> ModalString<T> {
             node_shapes: CacheAligned::new(NODE_CAPACITY * MODE_CAPACITY, T::default()),
             node_forces: vec![T::default(); NODE_CAPACITY],
             solver: StaticSolver::new(points + finger),
+            statics: NodalStatics::new(points + finger),
             loaded_forces: vec![T::default(); points],
             rest_modal: vec![0.0; MODE_CAPACITY],
             row: vec![0.0; MODE_CAPACITY],
@@ -450,42 +455,27 @@ impl<T: Real> ModalString<T> {
         } else {
             self.place_thread_lattice();
         }
-        self.configure_nodes();
     }
 
     /// With condensed grid modes, the nodes the points reach, their shapes and compliance
-    /// (section 11); the point-level solve otherwise, or when the points reach more than
-    /// [`NODE_CAPACITY`] nodes.
-    fn configure_nodes(&mut self) {
-        let (in_use, condensed) = match self.config.grid_modes {
-            Some(grid) if grid.condensed => (
-                self.nodal.configure(
-                    &self.points,
-                    &self.modes,
-                    grid.intervals,
-                    self.config.string.length_m,
-                ),
-                true,
-            ),
-            _ => (false, false),
-        };
-        self.nodal_in_use = in_use;
-        if condensed && !in_use {
-            // More nodes than the condensed solve holds: the point-level solve, which needs the
-            // coupling on the points that the condensed placement left out.
-            self.points.couple_from(
-                0,
+    /// (section 11): returns whether the contact is condensed on them. Not with other modes, nor
+    /// when the points reach more than [`NODE_CAPACITY`] nodes (the point-level solve then).
+    fn configure_nodes(&mut self) -> bool {
+        self.nodal_in_use = match self.config.grid_modes {
+            Some(grid) if grid.condensed => self.nodal.configure(
+                &self.points,
                 &self.modes,
-                self.config.static_flexibility,
-                &self.kernels,
-                true,
-            );
-        }
+                grid.intervals,
+                self.config.string.length_m,
+            ),
+            _ => false,
+        };
         if self.nodal_in_use {
             for (target, source) in self.node_shapes.iter_mut().zip(&self.nodal.node_shapes) {
                 *target = T::from_f64(*source);
             }
         }
+        self.nodal_in_use
     }
 
     /// Places the points, the thread's on the first of [`THREAD_LATTICES`] whose points all
@@ -623,16 +613,26 @@ impl<T: Real> ModalString<T> {
         self.couple_points_from(first);
     }
 
-    /// Couples the points `first..` to the modes (those before unchanged since they were).
+    /// Couples the points `first..` to the modes (those before unchanged since they were); with
+    /// the contact condensed on the grid's nodes, the nodes alone: every solve then works
+    /// through them (section 11), and the points' shape rows are never formed.
     fn couple_points_from(&mut self, first: usize) {
-        // From 0 with residual modes (`ContactPoints::couple_from`).
-        let condensed = matches!(self.config.grid_modes, Some(grid) if grid.condensed);
+        if self.configure_nodes() {
+            self.points.flexible = false;
+            return;
+        }
+        // From 0 after a condensed placement (whose rows were never formed) or with residual
+        // modes (`ContactPoints::couple_from`).
+        let first = if matches!(self.config.grid_modes, Some(grid) if grid.condensed) {
+            0
+        } else {
+            first
+        };
         let first = self.points.couple_from(
             first,
             &self.modes,
             self.config.static_flexibility,
             &self.kernels,
-            !condensed,
         );
         let rows = first * MODE_CAPACITY..;
         for (target, source) in self.shapes[rows.clone()]
@@ -667,21 +667,36 @@ impl<T: Real> ModalString<T> {
         self.non_finite_resets = 0;
     }
 
-    /// The static equilibrium on bridge and thread (section 5), warm-started from the last one.
+    /// The static equilibrium on bridge and thread (section 5), warm-started from the last one:
+    /// on the nodes with the condensed contact (`nodal_statics.rs`), else on the points.
     fn update_rest_state(&mut self) {
-        let count = self.solver.load_points(&self.points);
+        let count = self.points.len();
         let modes = self.modes.count();
-        self.solver.forces_n[..count].copy_from_slice(&self.points.rest_forces_n[..count]);
         self.rest_state_solves += 1;
-        if !self.solver.solve(count, modes) {
-            self.static_solve_failures += 1;
-        }
+        let (forces, displacements, modal) = if self.nodal_in_use {
+            if !self.solve_statics_on_nodes(|_| Ok(())) {
+                self.static_solve_failures += 1;
+            }
+            let statics = &self.statics;
+            (&statics.forces_n, &statics.displacements_m, &statics.modal)
+        } else {
+            let count = self.solver.load_points(&self.points);
+            self.solver.forces_n[..count].copy_from_slice(&self.points.rest_forces_n[..count]);
+            if !self.solver.solve(count, modes) {
+                self.static_solve_failures += 1;
+            }
+            let solver = &self.solver;
+            (&solver.forces_n, &solver.displacements_m, &solver.modal)
+        };
         self.rest_modal.fill(0.0);
-        self.rest_modal[..modes].copy_from_slice(&self.solver.modal[..modes]);
+        self.rest_modal[..modes].copy_from_slice(&modal[..modes]);
         for i in 0..count {
-            self.points.rest_forces_n[i] = self.solver.forces_n[i];
-            self.points.rest_gaps_m[i] =
-                self.points.free_gaps_m[i] - self.solver.displacements_m[i];
+            self.points.rest_forces_n[i] = forces[i];
+            self.points.rest_gaps_m[i] = self.points.free_gaps_m[i] - displacements[i];
+        }
+        if self.nodal_in_use {
+            self.nodal
+                .set_rest_forces(&self.points.rest_forces_n[..count]);
         }
         let string = &self.config.string;
         self.rest_nut_force_n = string.tension_n * string.left_support_m / string.length_m
@@ -689,6 +704,33 @@ impl<T: Real> ModalString<T> {
                 .map(|k| self.modes.nut_weight[k] * self.rest_modal[k])
                 .sum::<f64>();
         self.rest_bridge_force_n = self.points.rest_forces_n[..count].iter().sum();
+    }
+
+    /// Loads the bridge's and thread's points (from their rest forces) into the nodal static
+    /// solver, then whatever `more` adds (the finger's points), and solves: whether it
+    /// converged. A problem that does not fit the solver, or is not positive definite (neither
+    /// happens for a finite configuration), has the string free of every point as its solution.
+    fn solve_statics_on_nodes(
+        &mut self,
+        more: impl FnOnce(&mut NodalStatics) -> Result<(), nodal_statics::NodalStaticsError>,
+    ) -> bool {
+        let Some(grid) = self.config.grid_modes else {
+            return false;
+        };
+        let statics = &mut self.statics;
+        statics.begin(grid.intervals, self.config.string.length_m);
+        let posed = statics
+            .add_contact_points(&self.points)
+            .and_then(|()| more(statics))
+            .and_then(|()| statics.prepare(&self.modes))
+            .and_then(|()| statics.solve(&self.modes));
+        match posed {
+            Ok(converged) => converged,
+            Err(_) => {
+                statics.clear_solution();
+                false
+            }
+        }
     }
 
     /// The free step `s_free = a p − b r` for the current state: what a step starts
@@ -708,8 +750,25 @@ impl<T: Real> ModalString<T> {
     /// step.
     fn refresh_gaps(&mut self) {
         self.prepare_free_step();
-        for i in 0..self.points.len() {
-            self.contact.gaps_m[i] = self.modal_gap_m(i);
+        if self.nodal_in_use {
+            // Through the nodes: y = V r̃, a_i = a_rest,i − l_i · y.
+            let modes = self.modes.count();
+            let nodes = self.nodal.node_count();
+            for j in 0..nodes {
+                self.row[j] = self.nodal.node_shapes[j * MODE_CAPACITY..j * MODE_CAPACITY + modes]
+                    .iter()
+                    .zip(&self.modal[..modes])
+                    .map(|(v, r)| v * r.to_f64())
+                    .sum();
+            }
+            self.nodal
+                .gaps_from_nodes(&self.points.rest_gaps_m, &self.row[..nodes]);
+            let count = self.points.len();
+            self.contact.gaps_m[..count].copy_from_slice(&self.nodal.gaps_m[..count]);
+        } else {
+            for i in 0..self.points.len() {
+                self.contact.gaps_m[i] = self.modal_gap_m(i);
+            }
         }
         self.contact.classify(&self.points, TRACKING_BAND_M);
         self.classify_nodal();
@@ -1017,7 +1076,52 @@ impl<T: Real> ModalString<T> {
         let highest = length - half_width - 1e-3;
         let centre = pluck.position_m.clamp(lowest, highest.max(lowest));
         let top = self.rest_displacement_at_m(centre) + amplitude;
+        let modes = self.modes.count();
+        if self.nodal_in_use {
+            self.press_finger_on_nodes(centre, width, top);
+        } else {
+            self.press_finger_on_points(centre, width, top);
+        }
+        for k in 0..MODE_CAPACITY {
+            let pressed = if k < modes { self.row[k] } else { 0.0 };
+            self.modal[k] = T::from_f64(pressed - self.rest_modal[k]);
+        }
+        self.velocity.fill(T::default());
+        self.refresh_gaps();
+        self.external_work_j += self.energy_j() - energy_before;
+        self.refresh_outputs_at_rest_of_motion();
+    }
 
+    /// The pressed string of a pluck on the nodes (`nodal_statics.rs`): the finger's points
+    /// (`width` m wide, centred at `centre` m, its top at `top` m) join the bridge's and the
+    /// thread's; the pressed modal state is left in `row`.
+    fn press_finger_on_nodes(&mut self, centre: f64, width: f64, top: f64) {
+        let spacing = self.config.finger.spacing_m;
+        let finger_points = grid_points(0.0, width, spacing);
+        let (length, left) = (
+            self.config.string.length_m,
+            self.config.string.left_support_m,
+        );
+        let spring = self.config.finger.stiffness_n_m2 * spacing;
+        let half_width = 0.5 * width;
+        let converged = self.solve_statics_on_nodes(|statics| {
+            (0..finger_points).try_for_each(|index| {
+                let x = centre - half_width + index as f64 * spacing;
+                let gap = finger_height_m(x, centre, width, top) - left * (1.0 - x / length);
+                statics.add_point(x, gap, spring, 0.0)
+            })
+        });
+        if !converged {
+            self.static_solve_failures += 1;
+        }
+        let modes = self.modes.count();
+        self.row[..modes].copy_from_slice(&self.statics.modal[..modes]);
+    }
+
+    /// The pressed string of a pluck on the points (section 5, `solve.rs`); the pressed modal
+    /// state is left in `row`.
+    fn press_finger_on_points(&mut self, centre: f64, width: f64, top: f64) {
+        let (length, half_width) = (self.config.string.length_m, 0.5 * width);
         let count = self.solver.load_points(&self.points);
         let spacing = self.config.finger.spacing_m;
         let finger_points = grid_points(0.0, width, spacing).min(self.solver.capacity() - count);
@@ -1059,14 +1163,7 @@ impl<T: Real> ModalString<T> {
         if !self.solver.solve(count + finger_points, modes) {
             self.static_solve_failures += 1;
         }
-        for k in 0..MODE_CAPACITY {
-            let pressed = if k < modes { self.solver.modal[k] } else { 0.0 };
-            self.modal[k] = T::from_f64(pressed - self.rest_modal[k]);
-        }
-        self.velocity.fill(T::default());
-        self.refresh_gaps();
-        self.external_work_j += self.energy_j() - energy_before;
-        self.refresh_outputs_at_rest_of_motion();
+        self.row[..modes].copy_from_slice(&self.solver.modal[..modes]);
     }
 
     /// The seed's "first mode" initial condition: the rest shape plus `amplitude_m` times the
@@ -1233,13 +1330,36 @@ impl<T: Real> ModalString<T> {
     /// The fundamental of small vibrations about the rest state with every point in contact at
     /// rest acting as a spring of its stiffness, Hz (section 5). Allocation-free.
     pub fn linearised_fundamental_hz(&mut self) -> f64 {
-        linearised_fundamental(
-            &self.points,
-            &self.modes.angular_frequency,
-            self.modes.count(),
-            &mut self.solver,
-            TUNING_ITERATIONS,
-        ) / (2.0 * PI)
+        let omega = &self.modes.angular_frequency;
+        let modes = self.modes.count();
+        let angular = if self.nodal_in_use {
+            // On the nodes (`nodal_statics.rs`), with the contact points alone loaded.
+            let Some(grid) = self.config.grid_modes else {
+                return f64::NAN;
+            };
+            let statics = &mut self.statics;
+            statics.begin(grid.intervals, self.config.string.length_m);
+            if statics.add_contact_points(&self.points).is_err()
+                || statics.prepare(&self.modes).is_err()
+            {
+                return f64::NAN;
+            }
+            statics.linearised_fundamental(
+                &self.points.rest_forces_n,
+                omega,
+                modes,
+                TUNING_ITERATIONS,
+            )
+        } else {
+            linearised_fundamental(
+                &self.points,
+                omega,
+                modes,
+                &mut self.solver,
+                TUNING_ITERATIONS,
+            )
+        };
+        angular / (2.0 * PI)
     }
 
     /// The point nearest the nut in contact at rest, m: the start of the speaking length.
@@ -1510,6 +1630,81 @@ mod tests {
         }
         assert_eq!(lane_stats.iterations, general_stats.iterations);
         assert!(lane_stats.iterations > lane_stats.steps, "{lane_stats:?}");
+    }
+
+    /// The static problems solved on the nodes (`nodal_statics.rs`) are the point-level ones
+    /// (`solve.rs`) up to round-off, on the tier's spacings and the reference's, at a crest key
+    /// and above it: the rest state (every point's rest force, the modal rest state), the
+    /// linearised fundamental the voice tunes by, and a pluck's pressed string. f64 modes, so
+    /// that the comparison is not f32's.
+    #[test]
+    fn the_static_problems_on_the_nodes_are_the_point_level_ones() {
+        for (tension_n, bridge_m, thread_m) in [(52.0, 0.36e-3, 0.2e-3), (80.0, 0.18e-3, 0.15e-3)] {
+            let build = |condensed: bool| {
+                let mut config = ModalStringConfig {
+                    bridge_point_spacing_m: bridge_m,
+                    thread_point_spacing_m: thread_m,
+                    grid_modes: Some(GridModes {
+                        intervals: 200,
+                        time_step_s: 1.0 / (4.0 * 44_100.0),
+                        condensed,
+                    }),
+                    ..ModalStringConfig::REFERENCE
+                };
+                config.string.tension_n = tension_n;
+                let string = ModalString::<f64>::new(config);
+                assert_eq!(string.nodal_in_use, condensed);
+                string
+            };
+            let (mut nodes, mut points) = (build(true), build(false));
+            let count = points.points.len();
+            let largest = points.points.rest_forces_n[..count]
+                .iter()
+                .fold(0.0f64, |m, f| m.max(*f));
+            assert!(largest > 0.0);
+            for i in 0..count {
+                let (a, b) = (
+                    nodes.points.rest_forces_n[i],
+                    points.points.rest_forces_n[i],
+                );
+                assert!(
+                    (a - b).abs() <= 1e-9 * largest,
+                    "point {i}: {a} N against {b} N"
+                );
+            }
+            let close = |a: &[f64], b: &[f64], what: &str| {
+                let range = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let worst = a
+                    .iter()
+                    .zip(b)
+                    .map(|(x, y)| (x - y).abs())
+                    .fold(0.0, f64::max);
+                assert!(worst <= 1e-9 * range, "{what}: {worst:e} of {range:e}");
+            };
+            let modes = points.modes.count();
+            close(
+                &nodes.rest_modal[..modes],
+                &points.rest_modal[..modes],
+                "rest state",
+            );
+            let (f_nodes, f_points) = (
+                nodes.linearised_fundamental_hz(),
+                points.linearised_fundamental_hz(),
+            );
+            assert!(
+                (f_nodes / f_points - 1.0).abs() <= 1e-11,
+                "{f_nodes} Hz against {f_points} Hz"
+            );
+            nodes.pluck(&Pluck::default());
+            points.pluck(&Pluck::default());
+            close(
+                &nodes.modal[..modes],
+                &points.modal[..modes],
+                "pressed string",
+            );
+            assert_eq!(nodes.static_solve_failures(), 0);
+            assert_eq!(points.static_solve_failures(), 0);
+        }
     }
 
     /// The scalar fallback, the step a machine without AVX2 and FMA runs (the shipped binary

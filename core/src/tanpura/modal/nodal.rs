@@ -40,6 +40,7 @@
 //! [`NODE_CAPACITY`] unknowns and are solved once or twice per sample on the audio thread;
 //! nothing here allocates after [`NodalContact::new`].
 
+use super::lanes::{padded_lanes, Kernels};
 use super::modes::{ModeSet, MODE_CAPACITY};
 use super::points::ContactPoints;
 use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
@@ -176,6 +177,9 @@ pub struct NodalContact {
     matrix: Vec<f64>,
     right_side: Vec<f64>,
     scratch: Vec<f64>,
+    /// A node row times b (the compliance's rows), and the dot-product kernels.
+    weighted_row: Vec<f64>,
+    kernels: Kernels,
     /// The nodes with a non-zero force change after the step, and the changes, N.
     loaded_nodes: Vec<usize>,
     loaded_forces_n: Vec<f64>,
@@ -293,6 +297,8 @@ impl NodalContact {
             matrix: zeros(NODE_CAPACITY * NODE_CAPACITY),
             right_side: zeros(NODE_CAPACITY),
             scratch: zeros(NODE_CAPACITY),
+            weighted_row: zeros(MODE_CAPACITY),
+            kernels: Kernels::detect(),
             loaded_nodes: vec![0; NODE_CAPACITY],
             loaded_forces_n: zeros(NODE_CAPACITY),
             loaded_count: 0,
@@ -396,24 +402,44 @@ impl NodalContact {
                 (previous, current) = (current, twice_cos * current - previous);
             }
         }
+        let lanes = padded_lanes(modes_count);
         for j in 0..node_count {
+            let row_j = &self.node_shapes[j * MODE_CAPACITY..j * MODE_CAPACITY + lanes];
+            for ((weighted, v), b) in self.weighted_row.iter_mut().zip(row_j).zip(&modes.b) {
+                *weighted = v * b;
+            }
+            self.kernels.leading_dots(
+                &self.node_shapes,
+                MODE_CAPACITY,
+                &self.weighted_row[..lanes],
+                &mut self.scratch[..=j],
+            );
             for l in 0..=j {
-                let row_j = &self.node_shapes[j * MODE_CAPACITY..j * MODE_CAPACITY + modes_count];
-                let row_l = &self.node_shapes[l * MODE_CAPACITY..l * MODE_CAPACITY + modes_count];
-                let value: f64 = row_j
-                    .iter()
-                    .zip(row_l)
-                    .zip(&modes.b[..modes_count])
-                    .map(|((x, y), b)| x * y * b)
-                    .sum();
-                self.compliance[j * NODE_CAPACITY + l] = value;
-                self.compliance[l * NODE_CAPACITY + j] = value;
+                self.compliance[j * NODE_CAPACITY + l] = self.scratch[l];
+                self.compliance[l * NODE_CAPACITY + j] = self.scratch[l];
             }
         }
         self.node_corrections_m.fill(0.0);
         self.set_changed = true;
         self.set_mask = 0;
         true
+    }
+
+    /// Sets the points' rest forces, N (after the rest state is solved for the configuration).
+    pub fn set_rest_forces(&mut self, rest_forces_n: &[f64]) {
+        let count = self.point_count.min(rest_forces_n.len());
+        self.rest_forces_n[..count].copy_from_slice(&rest_forces_n[..count]);
+    }
+
+    /// Sets every point's gap from the nodes' displacements from rest `node_displacements_m`:
+    /// `a_i = a_rest,i − l_i · y`.
+    pub fn gaps_from_nodes(&mut self, rest_gaps_m: &[f64], node_displacements_m: &[f64]) {
+        for i in 0..self.point_count {
+            let displacement: f64 = (0..4)
+                .map(|j| self.weight_columns[j][i] * node_displacements_m[self.stencil_nodes[i][j]])
+                .sum();
+            self.gaps_m[i] = rest_gaps_m[i] - displacement;
+        }
     }
 
     /// Tracks the points within `band_m` of contact or loaded at rest, from scratch, with the

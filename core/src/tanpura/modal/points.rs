@@ -236,16 +236,13 @@ impl ContactPoints {
     /// Allocation-free; O(M K + M² K), the M² K part as SIMD dot products
     /// (`kernels.dots_pair`): each row i of G and of Ψ Ψᵀ up to the diagonal is
     /// `Ψ_j · (Ψ_i ⊙ b)` and `Ψ_j · Ψ_i` for j ≤ i. It runs on every retune of a ringing string
-    /// (each tuning pass), so it is on the audio thread's path. Without `with_coupling` only Ψ:
-    /// the contact condensed on the grid's nodes (`nodal.rs`) forms its coupling there, and G and
-    /// R are left as they were (neither is then read).
+    /// (each tuning pass), so it is on the audio thread's path.
     pub fn couple_from(
         &mut self,
         first: usize,
         modes: &ModeSet,
         flexible: bool,
         kernels: &Kernels,
-        with_coupling: bool,
     ) -> usize {
         let first = if modes.count() > modes.kept() {
             0
@@ -263,10 +260,6 @@ impl ContactPoints {
         }
         if modes.count() > modes.kept() {
             self.shape_residual_modes(modes, kernels);
-        }
-        if !with_coupling {
-            self.flexible = false;
-            return first;
         }
         for i in first..self.count {
             let row_i = &self.shapes[i * MODE_CAPACITY..i * MODE_CAPACITY + lanes];
@@ -438,7 +431,7 @@ mod tests {
         modes.configure(&StringParameters::SEED, 1.0 / 44_100.0, 20_000.0, None);
         let thread = ThreadSettings::SEED;
         let mut points = seed_points(1e-3, 1e-3, 0.0);
-        points.couple_from(0, &modes, true, &Kernels::detect(), true);
+        points.couple_from(0, &modes, true, &Kernels::detect());
         assert!(points.len() > 30);
         for i in 0..points.len() {
             assert!(points.coupling(i, i) > 0.0);
@@ -462,7 +455,7 @@ mod tests {
         let kernels = Kernels::detect();
         let placed = |thread_spacing_m: f64, thread_offset_m: f64| {
             let mut points = seed_points(2e-3, thread_spacing_m, thread_offset_m);
-            points.couple_from(0, &modes, true, &kernels, true);
+            points.couple_from(0, &modes, true, &kernels);
             points
         };
         let mut moved = placed(0.5e-3, 0.0);
@@ -475,7 +468,7 @@ mod tests {
             -2e-3,
             0.668,
         );
-        let recoupled = moved.couple_from(moved.bridge_count(), &modes, true, &kernels, true);
+        let recoupled = moved.couple_from(moved.bridge_count(), &modes, true, &kernels);
         assert_eq!(recoupled, moved.bridge_count());
         let whole = placed(0.55e-3, 0.275e-3);
         assert_eq!(moved.len(), whole.len());
