@@ -388,12 +388,12 @@ fn f32_modes_follow_the_f64_path() {
 /// `TanpuraVoice::process` (which runs a modal string's steps between sleep checks as one call
 /// on the vector unit) gives `next_sample`'s samples bit for bit, in blocks of every size from
 /// one sample up, through a pluck, its ringing, the sleep check and the string falling asleep,
-/// on both modal tiers.
+/// on every modal tier.
 #[test]
 fn modal_voice_blocks_equal_its_samples() {
     use javari_core::tanpura::quality::Quality;
     use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
-    for quality in [Quality::Live, Quality::Draft] {
+    for quality in [Quality::Live, Quality::Fine, Quality::Draft] {
         let settings = VoiceSettings {
             quality,
             // A short decay, so that the string falls asleep within the test.

@@ -8,9 +8,10 @@ use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
 
-/// The signature must hold for both discretisations: the seed's FD scheme (reference) and the
-/// modal scheme of the default tier (live).
-const TIERS: [Quality; 2] = [Quality::Live, Quality::Reference];
+/// The signature must hold for every discretisation: the seed's FD scheme (reference), the modal
+/// scheme on the reference's grid (fine, the default tier) and on the continuous string's modes
+/// (live).
+const TIERS: [Quality; 3] = [Quality::Live, Quality::Fine, Quality::Reference];
 
 const SAMPLE_RATE: f64 = 44_100.0;
 const WINDOW: usize = 8192;

@@ -397,7 +397,7 @@ mod tests {
         assert!((settings.voice.eta_s / 7e-9 - 1.0).abs() < 1e-6);
         assert_eq!(
             settings.voice.quality,
-            javari_core::tanpura::quality::Quality::Live
+            javari_core::tanpura::quality::Quality::default()
         );
         assert_eq!(settings.drone, expected.drone);
     }

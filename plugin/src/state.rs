@@ -347,7 +347,7 @@ mod tests {
             JavariParams::default().param_map().len()
         );
         assert_eq!(text(&state.params["gain"]), "F32(0.0)");
-        assert_eq!(text(&state.params["qual"]), r#"String("live")"#);
+        assert_eq!(text(&state.params["qual"]), r#"String("fine")"#);
     }
 
     #[test]

@@ -465,6 +465,7 @@ fn clap_latency_follows_the_tier_through_a_restart() {
     assert!(fd_latency > 0, "the FD tiers have a decimator delay");
     assert_eq!(engine_latency(Quality::Studio), fd_latency);
     assert_eq!(engine_latency(Quality::Live), 0);
+    assert_eq!(engine_latency(Quality::Fine), 0);
     assert_eq!(engine_latency(Quality::Draft), 0);
 
     let rate = 44_100.0;
@@ -476,16 +477,18 @@ fn clap_latency_follows_the_tier_through_a_restart() {
     assert_eq!(
         latency.get(&instance.plugin_handle()),
         0,
-        "live, the default"
+        "fine, the default"
     );
     assert_eq!(changes(&instance), 0);
-    // (CLAP plain value of an enum parameter: its index. Draft 0, live 1, studio 2, reference 3.)
+    // (CLAP plain value of an enum parameter: its index. Draft 0, live 1, fine 2, studio 3,
+    // reference 4.)
     let tiers = [
-        (2.0, Quality::Studio),
-        (3.0, Quality::Reference),
+        (3.0, Quality::Studio),
+        (4.0, Quality::Reference),
         (1.0, Quality::Live),
+        (2.0, Quality::Fine),
         (0.0, Quality::Draft),
-        (3.0, Quality::Reference),
+        (4.0, Quality::Reference),
     ];
     for (index, tier) in tiers {
         let before = latency.get(&instance.plugin_handle());

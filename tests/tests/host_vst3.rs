@@ -483,16 +483,18 @@ fn vst3_latency_follows_the_tier_through_a_restart() {
     let fd_latency = engine_latency(Quality::Reference);
     assert!(fd_latency > 0, "the FD tiers have a decimator delay");
     assert_eq!(engine_latency(Quality::Live), 0);
+    assert_eq!(engine_latency(Quality::Fine), 0);
 
     play(&component, &processor, 44_100.0, 64, 57, 0, 0.02);
     assert!(!latency_restart(), "a restart at the default tier");
-    assert_eq!(latency(), 0, "live, the default");
+    assert_eq!(latency(), 0, "fine, the default");
 
-    // Normalised enum values: draft 0, live 1/3, studio 2/3, reference 1.
+    // Normalised enum values: draft 0, live 1/4, fine 1/2, studio 3/4, reference 1.
     for (tier, value) in [
-        (Quality::Studio, 2.0 / 3.0),
+        (Quality::Studio, 0.75),
         (Quality::Reference, 1.0),
-        (Quality::Live, 1.0 / 3.0),
+        (Quality::Live, 0.25),
+        (Quality::Fine, 0.5),
         (Quality::Draft, 0.0),
         (Quality::Reference, 1.0),
     ] {

@@ -482,15 +482,17 @@ fn away_from_the_crest_markdown(results: &[TierOverGrid]) -> String {
     text
 }
 
-/// Rows for the targets table: the default and studio tiers' worst grid points against issue 15's
-/// targets (sustained pitch 1 cent, band levels 5 dB, centroid 15 %), and the draft tier's own
+/// Rows for the targets table: the live, fine (the default) and studio tiers' worst grid points
+/// against issue 15's targets (sustained pitch 1 cent, band levels 5 dB, centroid 15 %), and the
+/// draft tier's own
 /// (sustained pitch 1 cent, band levels below its highest mode 5 dB).
 pub fn target_rows(results: &[TierOverGrid]) -> Vec<(String, f64, f64, &'static str)> {
     let mut rows = Vec::new();
-    for tier in results
-        .iter()
-        .filter(|t| t.tier == Quality::Live.name() || t.tier == Quality::Studio.name())
-    {
+    for tier in results.iter().filter(|t| {
+        [Quality::Live, Quality::Fine, Quality::Studio]
+            .iter()
+            .any(|quality| t.tier == quality.name())
+    }) {
         rows.push((
             format!(
                 "{} tier, worst pluck of the range: sustained pitch within 1 cent",

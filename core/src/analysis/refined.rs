@@ -31,7 +31,7 @@ use crate::analysis::playing_range::{calibration_request, GridPoint, NOTE_SECOND
 use crate::tanpura::excitation::Pluck;
 use crate::tanpura::fd::decimator::render_decimated;
 use crate::tanpura::fd::FdString;
-use crate::tanpura::modal::{GridModes, ModalString};
+use crate::tanpura::modal::ModalString;
 use crate::tanpura::quality::Quality;
 use crate::tanpura::tier_string::weighted_pickup_n;
 use crate::tanpura::voice::tune_tension;
@@ -147,19 +147,7 @@ pub struct ModalVariant {
     pub grid_modes: bool,
 }
 
-/// The reference tier's grid as modes for a modal string at `output_sample_rate_hz`: its
-/// intervals, and the time step of its oversampled trapezoidal rule; the contact condensed on
-/// the grid's nodes.
-pub fn reference_grid_modes(output_sample_rate_hz: f64) -> GridModes {
-    let tier = Quality::Reference
-        .fd_tier()
-        .expect("the reference tier is an FD tier");
-    GridModes {
-        intervals: tier.intervals,
-        time_step_s: 1.0 / (output_sample_rate_hz * tier.oversample as f64),
-        condensed: true,
-    }
-}
+pub use crate::tanpura::quality::reference_grid_modes;
 
 impl Default for ModalVariant {
     fn default() -> Self {

@@ -75,7 +75,7 @@ use toml::Spanned;
 pub const PLUCK_POSITION_RANGE_M: (f64, f64) = (0.05, 0.6);
 
 /// Names of the quality tiers, as written in presets ([`Quality::name`]).
-pub const QUALITY_NAMES: [&str; 4] = ["draft", "live", "studio", "reference"];
+pub const QUALITY_NAMES: [&str; 5] = ["draft", "live", "fine", "studio", "reference"];
 
 /// Names of the instruments, bowed models and bowed strings, as written in presets.
 pub const INSTRUMENT_NAMES: [&str; 2] = ["tanpura", "bowed"];
@@ -820,7 +820,7 @@ mod tests {
             ("thread_enabled = yes", "true or false"),
             (
                 "quality = \"ultra\"",
-                "\"draft\", \"live\", \"studio\", \"reference\"",
+                "\"draft\", \"live\", \"fine\", \"studio\", \"reference\"",
             ),
             ("gamma_per_s = fast", "a number from 0 to 20"),
             ("bridge_stifness = 1e8", "a known key"),

@@ -419,10 +419,11 @@ pub fn as_played_calibration(
 }
 
 /// The tier on whose scheme a string of `quality` has its jawari set (module doc, *One jawari
-/// for the instrument*): the studio tier's on the reference's, every other tier's on its own.
+/// for the instrument*): the fine and studio tiers' on the reference's (both share its grid), every
+/// other tier's on its own.
 pub fn jawari_set_on(quality: Quality) -> Quality {
     match quality {
-        Quality::Studio => Quality::Reference,
+        Quality::Fine | Quality::Studio => Quality::Reference,
         other => other,
     }
 }

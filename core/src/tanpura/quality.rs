@@ -12,6 +12,18 @@
 //!   chord. Points every 2 mm instead of 1 mm make the live string 17–23 % faster and leave its
 //!   playing-range figures within the measures' own spread: mean changes of 0.01 cents and
 //!   0.05 dB, at most 0.13 cents and 1.4 dB at one pluck (`docs/performance.md`, stop 29).
+//! - Fine runs the modal scheme on the reference's own grid (`docs/modal-tanpura.md` §10–11): every
+//!   mode of the seed's FD grid (N = 200, the 199 sampled sines with the frequencies and decays
+//!   of its trapezoidal rule at 4× the output rate), advanced exactly at the output rate, with the
+//!   contact points every 0.36 mm of the bridge and 0.2 mm of the thread seen through the FD's
+//!   cubic interpolation and solved on the 11 grid nodes they reach (`modal/nodal.rs`), the rest
+//!   state, the finger's press and the tuning too (`modal/nodal_statics.rs`). It is the
+//!   reference's string in space and its partials in time, at a modal tier's cost; its jawari is
+//!   set on the reference's (`as_played::jawari_set_on`). Points 0.36 / 0.2 mm apart lie about as
+//!   near the reference as its own barrier grids' 0.18 / 0.15 mm do (worst pluck of the playing
+//!   range, linearised tuning: 0.68 against 0.54 cents, 7.74 against 7.61 dB, 12.65 against
+//!   12.91 %; `grid_against_refined -- --grid-spacings`); at 0.5 mm on the bridge the centroid
+//!   parts (22.8 %).
 //! - Studio and Reference run the seed's finite-difference scheme (`fd/`). Reference is the
 //!   seed's own discretisation (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm,
 //!   Δx_c = 0.15 mm) with a tolerance at round-off; Studio runs at 3 × 44.1 kHz and keeps the
@@ -29,13 +41,15 @@
 
 use crate::newton::NewtonSettings;
 use crate::tanpura::fd::SolverKind;
+use crate::tanpura::modal::GridModes;
 
-/// The four tiers, cheapest first.
+/// The five tiers, cheapest first; Fine is the plugin's default.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Quality {
     Draft,
-    #[default]
     Live,
+    #[default]
+    Fine,
     Studio,
     Reference,
 }
@@ -49,6 +63,9 @@ pub struct ModalTier {
     pub bridge_point_spacing_m: f64,
     pub thread_point_spacing_m: f64,
     pub newton: NewtonSettings,
+    /// Take the reference's FD grid's modes with the contact condensed on its nodes
+    /// (`modal/nodal.rs`) instead of the continuous string's modes.
+    pub grid_modes: bool,
 }
 
 /// The numerical choices of one finite-difference tier.
@@ -71,6 +88,20 @@ pub enum Tier {
     FiniteDifference(FdTier),
 }
 
+/// The reference tier's grid as modes for a modal string at `output_sample_rate_hz`: its
+/// intervals, and the time step of its oversampled trapezoidal rule; the contact condensed on
+/// the grid's nodes (`docs/modal-tanpura.md` §10–11). The fine tier's modes.
+pub fn reference_grid_modes(output_sample_rate_hz: f64) -> GridModes {
+    let (intervals, oversample) = Quality::Reference
+        .fd_tier()
+        .map_or((200, 4), |tier| (tier.intervals, tier.oversample));
+    GridModes {
+        intervals,
+        time_step_s: 1.0 / (output_sample_rate_hz * oversample as f64),
+        condensed: true,
+    }
+}
+
 /// Newton's tolerance and cap in every tier but the reference.
 const TIER_NEWTON: NewtonSettings = NewtonSettings {
     tolerance_m: 1e-12,
@@ -78,9 +109,10 @@ const TIER_NEWTON: NewtonSettings = NewtonSettings {
 };
 
 impl Quality {
-    pub const ALL: [Quality; 4] = [
+    pub const ALL: [Quality; 5] = [
         Quality::Draft,
         Quality::Live,
+        Quality::Fine,
         Quality::Studio,
         Quality::Reference,
     ];
@@ -92,12 +124,21 @@ impl Quality {
                 bridge_point_spacing_m: 2e-3,
                 thread_point_spacing_m: 1e-3,
                 newton: TIER_NEWTON,
+                grid_modes: false,
             }),
             Quality::Live => Tier::Modal(ModalTier {
                 highest_mode_hz: 20_000.0,
                 bridge_point_spacing_m: 2e-3,
                 thread_point_spacing_m: 0.5e-3,
                 newton: TIER_NEWTON,
+                grid_modes: false,
+            }),
+            Quality::Fine => Tier::Modal(ModalTier {
+                highest_mode_hz: 20_000.0,
+                bridge_point_spacing_m: 0.36e-3,
+                thread_point_spacing_m: 0.2e-3,
+                newton: TIER_NEWTON,
+                grid_modes: true,
             }),
             Quality::Studio => Tier::FiniteDifference(FdTier {
                 oversample: 3,
@@ -146,6 +187,7 @@ impl Quality {
         match self {
             Quality::Draft => "draft",
             Quality::Live => "live",
+            Quality::Fine => "fine",
             Quality::Studio => "studio",
             Quality::Reference => "reference",
         }
@@ -192,5 +234,30 @@ mod tests {
         let studio = Quality::Studio.fd_tier().unwrap();
         let reference = Quality::Reference.fd_tier().unwrap();
         assert!(studio.oversample < reference.oversample);
+    }
+
+    #[test]
+    fn fine_is_the_default_and_runs_the_reference_grid_on_its_nodes() {
+        assert_eq!(Quality::default(), Quality::Fine);
+        let fine = Quality::Fine.modal_tier().unwrap();
+        assert!(fine.grid_modes);
+        assert!(!Quality::Live.modal_tier().unwrap().grid_modes);
+        let grid = reference_grid_modes(48_000.0);
+        let reference = Quality::Reference.fd_tier().unwrap();
+        assert_eq!(grid.intervals, reference.intervals);
+        assert_eq!(
+            grid.time_step_s,
+            1.0 / (48_000.0 * reference.oversample as f64)
+        );
+        assert!(grid.condensed && grid.is_valid());
+        let settings = crate::tanpura::VoiceSettings::default();
+        let config = settings.modal_config_at(Quality::Fine, 48_000.0).unwrap();
+        assert_eq!(config.grid_modes, Some(grid));
+        let string = crate::tanpura::modal::ModalString::<f32>::new(config);
+        assert_eq!(string.modes().count(), reference.intervals - 1);
+        assert!(
+            string.contact_node_count() > 0,
+            "the contact is on the nodes"
+        );
     }
 }

@@ -24,7 +24,7 @@ use super::fd::decimator::Decimator;
 use super::fd::{FdString, FdStringConfig};
 use super::geometry::ThreadSettings;
 use super::modal::{ModalString, ModalStringConfig};
-use super::quality::Quality;
+use super::quality::{reference_grid_modes, Quality};
 use super::string::StringParameters;
 use super::tier_string::TierString;
 use crate::newton::NewtonStats;
@@ -273,6 +273,9 @@ impl VoiceSettings {
         });
         config.string = self.string_parameters(config.speaking_start_m());
         config.newton = tier.newton;
+        config.grid_modes = tier
+            .grid_modes
+            .then(|| reference_grid_modes(output_sample_rate_hz));
         Some(config)
     }
 
