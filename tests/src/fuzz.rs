@@ -214,8 +214,12 @@ impl SettingChange {
             }
             // The cheaper tiers only: Reference costs a second per input.
             SettingChange::Quality(index) => {
-                voice.quality =
-                    [Quality::Draft, Quality::Live, Quality::Studio][usize::from(index) % 3]
+                voice.quality = [
+                    Quality::Draft,
+                    Quality::Live,
+                    Quality::Fine,
+                    Quality::Studio,
+                ][usize::from(index) % 4]
             }
             SettingChange::PluckPosition(value) => {
                 settings.pluck.position_m = value.scaled(0.05, 0.6)

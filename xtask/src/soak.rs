@@ -56,7 +56,7 @@ pub struct SoakArgs {
     /// Seed of the scene's randomness (the same seed plays the same scene).
     #[arg(long, value_name = "S", default_value_t = 1)]
     seed: u64,
-    /// Quality tier: draft, live (the plugin's default), studio or reference.
+    /// Quality tier: draft, live, fine (the plugin's default), studio or reference.
     #[arg(long, value_name = "TIER", default_value = "live", value_parser = quality_name)]
     quality: Quality,
     /// Automate the quality tier too (switches among all four tiers).
@@ -73,7 +73,7 @@ pub struct SoakArgs {
 
 fn quality_name(text: &str) -> Result<Quality, String> {
     Quality::from_name(text.trim())
-        .ok_or_else(|| format!("`{text}` is not a tier: draft, live, studio or reference"))
+        .ok_or_else(|| format!("`{text}` is not a tier: draft, live, fine, studio or reference"))
 }
 
 // ---------------------------------------------------------------------------------------------

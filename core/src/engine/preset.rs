@@ -19,7 +19,7 @@
 //! | `eta_s` | s | 0–1e-6 | frequency-dependent loss η |
 //! | `nut_pickup_weight` | 1 | 0–1 | with output pickup: 1: nut force, 0: bridge force |
 //! | `tanpura_output` | text | pickup, radiated | the pickup forces, or the body's radiated sound |
-//! | `quality` | text | draft, live, studio, reference | speed against accuracy (`quality.rs`) |
+//! | `quality` | text | draft, live, fine, studio, reference | speed against accuracy (`quality.rs`) |
 //! | `pluck_position_m` | m | 0.05–0.6 | pluck point from the tuning bead |
 //! | `pluck_width_m` | m | 0.002–0.040 | fingertip width |
 //! | `pluck_amplitude_m` | m | 0–0.005 | finger lift at full velocity |
