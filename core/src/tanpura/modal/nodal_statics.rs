@@ -459,6 +459,12 @@ impl NodalStatics {
                     .sum();
             }
         };
+        // V x into `projection` and C V x into `sprung`.
+        let (kernels, shapes) = (&self.kernels, &self.shapes);
+        let project_and_spring = |x: &[f64], projection: &mut [f64], sprung: &mut [f64]| {
+            kernels.leading_dots(shapes, MODE_CAPACITY, x, &mut projection[..n]);
+            apply_springs(projection, sprung);
+        };
         // M = diag(1/ω²) in `inverse_squares`; x₀ = 1/ω and v = M x₀.
         let (x, product) = (&mut self.iterate, &mut self.product);
         let inverse_squares = &mut self.inverse_squares;
@@ -474,13 +480,7 @@ impl NodalStatics {
         let (mut squared, mut mass) = ([0.0], [0.0]);
         for _ in 0..iterations {
             // x ← v − Vᵀ [C − C (K + C)⁻¹ C] V v.
-            self.kernels.leading_dots(
-                &self.shapes,
-                MODE_CAPACITY,
-                &product[..lanes],
-                &mut self.column[..n],
-            );
-            apply_springs(&self.column, &mut self.scratch);
+            project_and_spring(&product[..lanes], &mut self.column, &mut self.scratch);
             self.column[..n].copy_from_slice(&self.scratch[..n]);
             if n > 0 {
                 self.factor.solve_in_place(&mut self.column[..n]);
@@ -501,7 +501,7 @@ impl NodalStatics {
             for k in 0..lanes {
                 product[k] = x[k] * inverse_squares[k];
             }
-            self.kernels.dots_pair(
+            kernels.dots_pair(
                 &x[..lanes],
                 lanes,
                 &[0],
@@ -510,13 +510,7 @@ impl NodalStatics {
                 &mut squared,
                 &mut mass,
             );
-            self.kernels.leading_dots(
-                &self.shapes,
-                MODE_CAPACITY,
-                &x[..lanes],
-                &mut self.column[..n],
-            );
-            apply_springs(&self.column, &mut self.scratch);
+            project_and_spring(&x[..lanes], &mut self.column, &mut self.scratch);
             let stiffness = squared[0]
                 + (0..n)
                     .map(|j| self.column[j] * self.scratch[j])
