@@ -78,10 +78,12 @@ fn grid_modes_rest_where_the_reference_grid_rests() {
 /// The contact condensed on the grid's nodes (section 11) solves the same scheme as the
 /// point-level solve (section 4): on points as fine as the reference's barrier grids, at the
 /// tensions of a crest key and of key 60, the two play the same string, their pickup forces
-/// within 1e-9 of the force's range over 0.3 s, and Newton takes at most 5 % more updates on the
-/// nodes (measured: 3.41 against 3.33 per step at key 51, where the point-level solve's exact
-/// finish for one crossing point saves some; 2.71 against 2.72 and 1.10 against 1.10 at key 60).
-/// Hard plucks and soft ones: the contact cases differ.
+/// within 1e-9 of the force's range over 0.3 s. Newton takes fewer updates on the nodes: both
+/// solves finish a step with one crossing point exactly, the point-level one only while at most
+/// 8 points are in contact, the nodal one always (measured since stop 43: 2.76 against 3.21 per
+/// step at key 51, 2.19 against 2.72 and 1.07 against 1.10 at key 60; before the nodal finish
+/// 3.41 against 3.33, 2.71 against 2.72 and 1.10 against 1.10, which the 2 % this test asks
+/// fails). Hard plucks and soft ones: the contact cases differ.
 #[test]
 fn the_nodal_contact_plays_what_the_point_contact_plays() {
     use javari_core::tanpura::excitation::Pluck;
@@ -129,7 +131,7 @@ fn the_nodal_contact_plays_what_the_point_contact_plays() {
             );
         }
         assert!(
-            node_updates <= 1.05 * point_updates,
+            node_updates <= 0.98 * point_updates,
             "key {key}: {node_updates} updates per step on the nodes, {point_updates} on the points"
         );
     }

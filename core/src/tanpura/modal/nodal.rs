@@ -40,10 +40,13 @@
 //! [`NODE_CAPACITY`] unknowns and are solved once or twice per sample on the audio thread;
 //! nothing here allocates after [`NodalContact::new`].
 
+use super::block::{exact_crossing_step, CrossingPoint};
 use super::lanes::{padded_lanes, Kernels};
 use super::modes::{ModeSet, MODE_CAPACITY};
 use super::points::ContactPoints;
-use super::solve::{ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed};
+use super::solve::{
+    ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed, ldl_substitute_in_place,
+};
 use crate::newton::NewtonSettings;
 use crate::tanpura::contact::HuntCrossley;
 use crate::tanpura::fd::barrier_grid::lagrange_stencil;
@@ -558,11 +561,12 @@ impl NodalContact {
 
     /// Every tracked point's step, force, c and case at the iterate on S, in chunks of
     /// [`LANES`], and the nodal force change on S. Returns whether a
-    /// point's case changed since the last evaluation, and whether a point crosses.
+    /// point's case changed since the last evaluation, how many points cross, and the last of
+    /// them.
     #[inline(always)]
-    fn evaluate(&mut self) -> (bool, bool) {
+    fn evaluate(&mut self) -> (bool, usize, usize) {
         self.slot_forces[..self.set_count].fill(0.0);
-        let (mut changed, mut crossing) = (false, false);
+        let (mut changed, mut crossings, mut crossing_point) = (false, 0, UNSET);
         for index in 0..self.segment_count {
             let segment = self.segments[index];
             let y = segment.places.map(|slot| self.slot_steps[slot]);
@@ -598,7 +602,10 @@ impl NodalContact {
                 for (l, (&case, previous)) in cases.iter().zip(&mut self.cases[lanes]).enumerate() {
                     if l < valid {
                         changed |= case != *previous;
-                        crossing |= case == CROSSING;
+                        if case == CROSSING {
+                            crossings += 1;
+                            crossing_point = start + l;
+                        }
                         *previous = case;
                     }
                 }
@@ -619,7 +626,7 @@ impl NodalContact {
                 self.slot_forces[*slot] += sum;
             }
         }
-        (changed, crossing)
+        (changed, crossings, crossing_point)
     }
 
     /// Each segment's `Σ c w_j w_l` over [`PAIRS`] at the last evaluation (only before an
@@ -653,7 +660,7 @@ impl NodalContact {
     /// Newton's iteration on S from the iterate in `slot_steps`. Returns (updates, converged).
     #[inline(always)]
     fn newton(&mut self, settings: &NewtonSettings) -> (u32, bool) {
-        self.evaluate();
+        let (_, mut crossings, mut crossing_point) = self.evaluate();
         let mut updates = 0;
         loop {
             if updates >= settings.max_iterations {
@@ -668,24 +675,75 @@ impl NodalContact {
             };
             #[cfg(not(test))]
             let size = self.set_count;
-            let largest = match size {
-                0..=8 => self.update_in_lanes::<8>(),
-                9..=16 => self.update_in_lanes::<16>(),
-                _ => self.update_general(),
+            // One point crossing the contact's edge and every other in a linear case: the
+            // update finishes the step exactly (`NodalContact::exact_departure`).
+            let crossing = (crossings == 1).then_some(crossing_point);
+            let (largest, finished) = match size {
+                0..=8 => self.update_in_lanes::<8>(crossing),
+                9..=16 => self.update_in_lanes::<16>(crossing),
+                _ => self.update_general(crossing),
             };
             updates += 1;
-            let (changed, crossing) = self.evaluate();
-            if !(changed || crossing) || largest <= settings.tolerance_m {
+            let changed;
+            (changed, crossings, crossing_point) = self.evaluate();
+            // An exact finish stands if every point kept the case it was solved in.
+            if !(changed || crossings > 0)
+                || largest <= settings.tolerance_m
+                || (finished && !changed)
+            {
                 return (updates, true);
             }
         }
     }
 
+    /// `l_c` of point `c` on the slots of S, into `column` (zeros elsewhere).
+    #[inline(always)]
+    fn crossing_column(&self, c: usize, column: &mut [f64]) {
+        column.fill(0.0);
+        for (j, &node) in self.stencil_nodes[c].iter().enumerate() {
+            column[self.node_slots[node]] += self.weight_columns[j][c];
+        }
+    }
+
+    /// The exact finish of a step whose one crossing point is `c` (section 4, in the nodes):
+    /// with every other point in a linear case the scheme's equations are
+    /// `A (Δy − Δy⁰) = ρ_N + l_c ρ(s_c)`, `A = H + Σ c l lᵀ` at the evaluation, where `ρ(s)` is
+    /// the crossing law's departure from its tangent, so `Δy = Δy⁰ + δ + ρ w` with Newton's
+    /// update δ and `w = A⁻¹ l_c` (`direction`), and the point's own equation
+    /// `s = s⁰ + l_c·δ + (l_c·w) ρ(s)` is the point-level one (`block.rs`,
+    /// [`exact_crossing_step`]). Returns ρ at its root, or `None` where neither case holds one.
+    #[inline(always)]
+    fn exact_departure(&self, c: usize, delta: &[f64], direction: &[f64]) -> Option<f64> {
+        let along = |values: &[f64]| -> f64 {
+            (0..4)
+                .map(|j| {
+                    self.weight_columns[j][c] * values[self.node_slots[self.stencil_nodes[c][j]]]
+                })
+                .sum()
+        };
+        exact_crossing_step(CrossingPoint {
+            gap: self.gaps_m[c],
+            start: self.point_steps[c],
+            law: HuntCrossley {
+                xi: self.xis[c],
+                psi: self.psis[c],
+            },
+            force: self.point_forces[c],
+            stiffness: self.point_stiffnesses[c],
+            direction: along(direction),
+            delta: along(delta),
+        })
+        .map(|(_, departure)| departure)
+        .filter(|departure| departure.is_finite())
+    }
+
     /// One update (N1), `(H + Σ c l lᵀ) δ = f − H (Δy − Δy_free)`, applied to the iterate, in
     /// `N ≥ |S|` fixed lanes padded with the identity (the padding solves δ = 0). Up to 8 and up
     /// to 16 nodes (every step of the bench's scenes). Returns max|δ|.
+    /// With `crossing`, the step is finished exactly where it can be
+    /// ([`NodalContact::exact_departure`]); returns whether it was.
     #[inline(always)]
-    fn update_in_lanes<const N: usize>(&mut self) -> f64 {
+    fn update_in_lanes<const N: usize>(&mut self, crossing: Option<usize>) -> (f64, bool) {
         let m = self.set_count;
         let mut matrix = [[0.0; N]; N];
         let mut delta = [0.0; N];
@@ -704,11 +762,22 @@ impl NodalContact {
         self.add_stiffnesses(|a, b, value| matrix[a][b] += value);
         ldl_factor_fixed(&mut matrix);
         ldl_substitute_fixed(&matrix, &mut delta);
-        self.apply_update(&delta[..m])
+        if let Some(c) = crossing {
+            let mut direction = [0.0; N];
+            self.crossing_column(c, &mut direction[..m]);
+            ldl_substitute_fixed(&matrix, &mut direction);
+            if let Some(departure) = self.exact_departure(c, &delta, &direction) {
+                for (d, w) in delta[..m].iter_mut().zip(&direction) {
+                    *d += departure * w;
+                }
+                return (self.apply_update(&delta[..m]), true);
+            }
+        }
+        (self.apply_update(&delta[..m]), false)
     }
 
     /// [`NodalContact::update_in_lanes`] on any number of nodes (stride m, lower triangle).
-    fn update_general(&mut self) -> f64 {
+    fn update_general(&mut self, crossing: Option<usize>) -> (f64, bool) {
         let m = self.set_count;
         for a in 0..m {
             let mut rhs = self.slot_forces[a];
@@ -728,10 +797,23 @@ impl NodalContact {
             &mut self.right_side[..m],
             &mut self.scratch[..m],
         );
-        let delta = std::mem::take(&mut self.right_side);
+        let mut delta = std::mem::take(&mut self.right_side);
+        let mut finished = false;
+        if let Some(c) = crossing {
+            let mut direction = std::mem::take(&mut self.scratch);
+            self.crossing_column(c, &mut direction[..m]);
+            ldl_substitute_in_place(&self.matrix[..m * m], m, &mut direction[..m]);
+            if let Some(departure) = self.exact_departure(c, &delta[..m], &direction[..m]) {
+                for (d, w) in delta[..m].iter_mut().zip(&direction[..m]) {
+                    *d += departure * w;
+                }
+                finished = true;
+            }
+            self.scratch = direction;
+        }
         let largest = self.apply_update(&delta[..m]);
         self.right_side = delta;
-        largest
+        (largest, finished)
     }
 
     /// Calls `add(a, b, value)` with each segment's `Σ c w_j w_l` at its slots, a ≥ b (the lower

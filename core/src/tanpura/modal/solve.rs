@@ -43,19 +43,24 @@ pub(super) fn ldl_solve_in_place(matrix: &mut [f64], n: usize, x: &mut [f64], sc
             matrix[i * n + j] = (matrix[i * n + j] - sum) / diagonal;
         }
     }
-    // L y = b, then D z = y, then Lᵀ x = z.
+    ldl_substitute_in_place(matrix, n, x);
+}
+
+/// Solves with the factors [`ldl_solve_in_place`] leaves in `factors` (another right-hand side
+/// for the same matrix): `L y = b`, `D z = y`, `Lᵀ x = z`, in place.
+pub(super) fn ldl_substitute_in_place(factors: &[f64], n: usize, x: &mut [f64]) {
     for i in 0..n {
-        let row = &matrix[i * n..i * n + i];
+        let row = &factors[i * n..i * n + i];
         let sum: f64 = row.iter().zip(&x[..i]).map(|(l, v)| l * v).sum();
         x[i] -= sum;
     }
     for i in 0..n {
-        x[i] /= matrix[i * n + i];
+        x[i] /= factors[i * n + i];
     }
     for i in (0..n).rev() {
         let value = x[i];
         for k in 0..i {
-            x[k] -= matrix[i * n + k] * value;
+            x[k] -= factors[i * n + k] * value;
         }
     }
 }
