@@ -52,7 +52,7 @@ use lanes::{padded_lanes, AdvanceAndPrepare, Dots, Kernels, LeadingDots, Real, L
 pub use modes::GridModes;
 use modes::{ModeSet, AUDIBLE_LIMIT_HZ, MODE_CAPACITY};
 use nodal::{NodalContact, NODE_CAPACITY};
-use nodal_statics::NodalStatics;
+use nodal_statics::{NodalStatics, NodalStaticsError};
 use points::{grid_points, ContactPoints};
 use pulp::{Simd, WithSimd};
 use solve::{linearised_fundamental, StaticSolver};
@@ -706,31 +706,37 @@ impl<T: Real> ModalString<T> {
         self.rest_bridge_force_n = self.points.rest_forces_n[..count].iter().sum();
     }
 
-    /// Loads the bridge's and thread's points (from their rest forces) into the nodal static
-    /// solver, then whatever `more` adds (the finger's points), and solves: whether it
-    /// converged. A problem that does not fit the solver, or is not positive definite (neither
+    /// Solves the static problem [`Self::pose_statics_on_nodes`] poses (the bridge's and
+    /// thread's points, and whatever `more` adds: the finger's points): whether it converged. A problem that does not fit the solver, or is not positive definite (neither
     /// happens for a finite configuration), has the string free of every point as its solution.
     fn solve_statics_on_nodes(
         &mut self,
-        more: impl FnOnce(&mut NodalStatics) -> Result<(), nodal_statics::NodalStaticsError>,
+        more: impl FnOnce(&mut NodalStatics) -> Result<(), NodalStaticsError>,
     ) -> bool {
-        let Some(grid) = self.config.grid_modes else {
-            return false;
-        };
-        let statics = &mut self.statics;
-        statics.begin(grid.intervals, self.config.string.length_m);
-        let posed = statics
-            .add_contact_points(&self.points)
-            .and_then(|()| more(statics))
-            .and_then(|()| statics.prepare(&self.modes))
-            .and_then(|()| statics.solve(&self.modes));
+        let posed = self
+            .pose_statics_on_nodes(more)
+            .and_then(|()| self.statics.solve(&self.modes));
         match posed {
             Ok(converged) => converged,
             Err(_) => {
-                statics.clear_solution();
+                self.statics.clear_solution();
                 false
             }
         }
+    }
+
+    /// Loads the bridge's and thread's points (from their rest forces) into the nodal static
+    /// solver, then whatever `more` adds, and prepares the nodes' rows and stiffness.
+    fn pose_statics_on_nodes(
+        &mut self,
+        more: impl FnOnce(&mut NodalStatics) -> Result<(), NodalStaticsError>,
+    ) -> Result<(), NodalStaticsError> {
+        let grid = self.config.grid_modes.ok_or(NodalStaticsError::NoGrid)?;
+        let statics = &mut self.statics;
+        statics.begin(grid.intervals, self.config.string.length_m);
+        statics.add_contact_points(&self.points)?;
+        more(statics)?;
+        statics.prepare(&self.modes)
     }
 
     /// The free step `s_free = a p − b r` for the current state: what a step starts
@@ -1098,16 +1104,11 @@ impl<T: Real> ModalString<T> {
     fn press_finger_on_nodes(&mut self, centre: f64, width: f64, top: f64) {
         let spacing = self.config.finger.spacing_m;
         let finger_points = grid_points(0.0, width, spacing);
-        let (length, left) = (
-            self.config.string.length_m,
-            self.config.string.left_support_m,
-        );
         let spring = self.config.finger.stiffness_n_m2 * spacing;
-        let half_width = 0.5 * width;
+        let finger = FingerPress::new(&self.config, centre, width, top);
         let converged = self.solve_statics_on_nodes(|statics| {
             (0..finger_points).try_for_each(|index| {
-                let x = centre - half_width + index as f64 * spacing;
-                let gap = finger_height_m(x, centre, width, top) - left * (1.0 - x / length);
+                let (x, gap) = finger.point(index);
                 statics.add_point(x, gap, spring, 0.0)
             })
         });
@@ -1121,20 +1122,18 @@ impl<T: Real> ModalString<T> {
     /// The pressed string of a pluck on the points (section 5, `solve.rs`); the pressed modal
     /// state is left in `row`.
     fn press_finger_on_points(&mut self, centre: f64, width: f64, top: f64) {
-        let (length, half_width) = (self.config.string.length_m, 0.5 * width);
         let count = self.solver.load_points(&self.points);
         let spacing = self.config.finger.spacing_m;
         let finger_points = grid_points(0.0, width, spacing).min(self.solver.capacity() - count);
-        let left = self.config.string.left_support_m;
+        let finger = FingerPress::new(&self.config, centre, width, top);
         for index in 0..finger_points {
-            let x = centre - half_width + index as f64 * spacing;
+            let (x, gap) = finger.point(index);
             let row = count + index;
             self.modes.shape_row(
                 x,
                 &mut self.solver.shapes[row * MODE_CAPACITY..(row + 1) * MODE_CAPACITY],
             );
-            self.solver.free_gaps_m[row] =
-                finger_height_m(x, centre, width, top) - left * (1.0 - x / length);
+            self.solver.free_gaps_m[row] = gap;
             self.solver.springs_n_m[row] = self.config.finger.stiffness_n_m2 * spacing;
             self.solver.forces_n[row] = 0.0;
             // The truncated modes' compliance between this finger point and every row so far.
@@ -1143,7 +1142,7 @@ impl<T: Real> ModalString<T> {
                     let x_other = if other < count {
                         self.points.positions_m[other]
                     } else {
-                        centre - half_width + (other - count) as f64 * spacing
+                        finger.point(other - count).0
                     };
                     let shapes = &self.solver.shapes;
                     self.modes.residual_compliance_m_n(
@@ -1330,30 +1329,22 @@ impl<T: Real> ModalString<T> {
     /// The fundamental of small vibrations about the rest state with every point in contact at
     /// rest acting as a spring of its stiffness, Hz (section 5). Allocation-free.
     pub fn linearised_fundamental_hz(&mut self) -> f64 {
-        let omega = &self.modes.angular_frequency;
         let modes = self.modes.count();
         let angular = if self.nodal_in_use {
             // On the nodes (`nodal_statics.rs`), with the contact points alone loaded.
-            let Some(grid) = self.config.grid_modes else {
-                return f64::NAN;
-            };
-            let statics = &mut self.statics;
-            statics.begin(grid.intervals, self.config.string.length_m);
-            if statics.add_contact_points(&self.points).is_err()
-                || statics.prepare(&self.modes).is_err()
-            {
+            if self.pose_statics_on_nodes(|_| Ok(())).is_err() {
                 return f64::NAN;
             }
-            statics.linearised_fundamental(
+            self.statics.linearised_fundamental(
                 &self.points.rest_forces_n,
-                omega,
+                &self.modes.angular_frequency,
                 modes,
                 TUNING_ITERATIONS,
             )
         } else {
             linearised_fundamental(
                 &self.points,
-                omega,
+                &self.modes.angular_frequency,
                 modes,
                 &mut self.solver,
                 TUNING_ITERATIONS,
@@ -1368,6 +1359,38 @@ impl<T: Real> ModalString<T> {
             .filter(|&i| self.points.rest_forces_n[i] > 0.0)
             .map(|i| self.points.positions_m[i])
             .reduce(f64::max)
+    }
+}
+
+/// The finger of a pluck pressed with its top at `top` m: its points every `spacing` across
+/// `width` m centred at `centre` m, each with its free gap from the line between the supports.
+struct FingerPress {
+    centre: f64,
+    width: f64,
+    top: f64,
+    spacing: f64,
+    length: f64,
+    left: f64,
+}
+
+impl FingerPress {
+    fn new(config: &ModalStringConfig, centre: f64, width: f64, top: f64) -> Self {
+        Self {
+            centre,
+            width,
+            top,
+            spacing: config.finger.spacing_m,
+            length: config.string.length_m,
+            left: config.string.left_support_m,
+        }
+    }
+
+    /// The finger's point `index`: its position and free gap, m.
+    fn point(&self, index: usize) -> (f64, f64) {
+        let x = self.centre - 0.5 * self.width + index as f64 * self.spacing;
+        let gap = finger_height_m(x, self.centre, self.width, self.top)
+            - self.left * (1.0 - x / self.length);
+        (x, gap)
     }
 }
 

@@ -247,6 +247,23 @@ fn law_lane(gap: f64, step: f64, xi: f64, psi: f64) -> (f64, f64, f64) {
     (force, stiffness, case)
 }
 
+/// Node `node`'s row of V into `row` (MODE_CAPACITY long): `V_k = sin(kπ n/N)/√κ_k` over the
+/// modes, zeros beyond them, the sines by the recurrence `sin((k+1)θ) = 2 cos θ sin(kθ) −
+/// sin((k−1)θ)`. The condensed step's and the static problems' node rows are the same.
+pub(super) fn write_node_row(node: usize, intervals: usize, modes: &ModeSet, row: &mut [f64]) {
+    row.fill(0.0);
+    let theta = PI * node as f64 / intervals as f64;
+    let twice_cos = 2.0 * theta.cos();
+    let (mut previous, mut current) = (0.0, theta.sin());
+    for (value, scale) in row[..modes.count()]
+        .iter_mut()
+        .zip(&modes.inverse_root_stiffness)
+    {
+        *value = current * scale;
+        (previous, current) = (current, twice_cos * current - previous);
+    }
+}
+
 /// A chunk of [`LANES`] values of `values` from `start` (the arrays are padded).
 #[inline(always)]
 fn chunk(values: &[f64], start: usize) -> [f64; LANES] {
@@ -392,18 +409,7 @@ impl NodalContact {
         let modes_count = modes.count();
         for (j, &node) in self.grid_nodes[..node_count].iter().enumerate() {
             let row = &mut self.node_shapes[j * MODE_CAPACITY..(j + 1) * MODE_CAPACITY];
-            row.fill(0.0);
-            // sin(kθ), θ = π n/N, by the recurrence sin((k+1)θ) = 2 cos θ sin(kθ) − sin((k−1)θ).
-            let theta = PI * node as f64 / intervals as f64;
-            let twice_cos = 2.0 * theta.cos();
-            let (mut previous, mut current) = (0.0, theta.sin());
-            for (value, scale) in row[..modes_count]
-                .iter_mut()
-                .zip(&modes.inverse_root_stiffness)
-            {
-                *value = current * scale;
-                (previous, current) = (current, twice_cos * current - previous);
-            }
+            write_node_row(node, intervals, modes, row);
         }
         let lanes = padded_lanes(modes_count);
         for j in 0..node_count {

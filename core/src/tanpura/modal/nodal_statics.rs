@@ -32,11 +32,10 @@
 
 use super::lanes::{padded_lanes, Kernels};
 use super::modes::{ModeSet, MODE_CAPACITY};
-use super::nodal::NODE_CAPACITY;
+use super::nodal::{write_node_row, NODE_CAPACITY};
 use super::points::ContactPoints;
 use crate::dense::DenseCholesky;
 use crate::tanpura::fd::barrier_grid::lagrange_stencil;
-use std::f64::consts::PI;
 
 /// The most nodes a static problem may reach: the contact's ([`NODE_CAPACITY`]) and a finger's
 /// (at most 40 mm wide: 20 nodes on the finest valid grid, 2.6 mm).
@@ -54,6 +53,8 @@ pub enum NodalStaticsError {
     OutOfRoom,
     /// G or the Newton matrix was not positive definite (a non-finite configuration).
     NotPositiveDefinite,
+    /// The string does not take a grid's modes, so it has no nodes.
+    NoGrid,
 }
 
 /// The static solver on the nodes of a grid-mode string; allocation-free after
@@ -209,11 +210,6 @@ impl NodalStatics {
         Ok(())
     }
 
-    /// How many nodes the points reach.
-    pub fn node_count(&self) -> usize {
-        self.node_count
-    }
-
     /// V on the nodes (the sampled sines over √κ, by recurrence over the modes) and K = G⁻¹.
     pub fn prepare(&mut self, modes: &ModeSet) -> Result<(), NodalStaticsError> {
         let n = self.node_count;
@@ -221,15 +217,7 @@ impl NodalStatics {
         let lanes = padded_lanes(count);
         for (j, &node) in self.grid_nodes[..n].iter().enumerate() {
             let row = &mut self.shapes[j * MODE_CAPACITY..(j + 1) * MODE_CAPACITY];
-            row.fill(0.0);
-            // sin(kθ), θ = π n/N: sin((k+1)θ) = 2 cos θ sin(kθ) − sin((k−1)θ).
-            let theta = PI * node as f64 / self.intervals as f64;
-            let twice_cos = 2.0 * theta.cos();
-            let (mut previous, mut current) = (0.0, theta.sin());
-            for (value, scale) in row[..count].iter_mut().zip(&modes.inverse_root_stiffness) {
-                *value = current * scale;
-                (previous, current) = (current, twice_cos * current - previous);
-            }
+            write_node_row(node, self.intervals, modes, row);
         }
         // G = V Vᵀ (lower triangle by rows, mirrored), factorised, and K = G⁻¹ column by column.
         for j in 0..n {
