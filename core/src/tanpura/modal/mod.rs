@@ -965,12 +965,14 @@ impl<T: Real> ModalString<T> {
     #[inline(always)]
     fn step_on_nodes<S: Simd>(&mut self, simd: S) {
         let lanes = self.lanes;
-        let nodes = self.nodal.node_count();
+        // Whole groups of four rows (the dots past the nodes are never read), so that every
+        // row takes the four-row kernel: NODE_CAPACITY is a multiple of four.
+        let rows = self.nodal.node_count().next_multiple_of(4);
         LeadingDots {
             matrix: &self.node_shapes,
             stride: MODE_CAPACITY,
             x: &self.step[..lanes],
-            out: &mut self.nodal.node_free_steps_m[..nodes],
+            out: &mut self.nodal.node_free_steps_m[..rows],
         }
         .with_simd(simd);
         let outcome = self.nodal.step(

@@ -56,6 +56,10 @@ use std::f64::consts::PI;
 /// point-level solve (`step.rs`).
 pub const NODE_CAPACITY: usize = 48;
 const _: () = assert!(NODE_CAPACITY <= 64, "the node set is a u64 mask");
+const _: () = assert!(
+    NODE_CAPACITY.is_multiple_of(4),
+    "the node rows are dotted in fours"
+);
 const UNSET: usize = usize::MAX;
 /// The points are evaluated in chunks of this many lanes (loops over fixed arrays that the
 /// compiler vectorises); the per-point arrays are padded by as many.
@@ -576,6 +580,7 @@ impl NodalContact {
         for index in 0..self.segment_count {
             let segment = self.segments[index];
             let y = segment.places.map(|slot| self.slot_steps[slot]);
+            let mut force_sums = [0.0; 4];
             let mut start = segment.start;
             while start < segment.end {
                 let valid = (segment.end - start).min(LANES);
@@ -604,29 +609,25 @@ impl NodalContact {
                 let lanes = start..start + LANES;
                 self.point_steps[lanes.clone()].copy_from_slice(&steps);
                 self.point_forces[lanes.clone()].copy_from_slice(&forces);
-                self.point_stiffnesses[lanes.clone()].copy_from_slice(&stiffnesses);
-                for (l, (&case, previous)) in cases.iter().zip(&mut self.cases[lanes]).enumerate() {
-                    if l < valid {
-                        changed |= case != *previous;
-                        if case == CROSSING {
-                            crossings += 1;
-                            crossing_point = start + l;
-                        }
-                        *previous = case;
+                self.point_stiffnesses[lanes].copy_from_slice(&stiffnesses);
+                // The cases and the nodal force change of the segment's own lanes, in point
+                // order. A point at its rest force adds a zero product, which leaves every sum
+                // as it was.
+                let rests = chunk(&self.rest_forces_n, start);
+                for (l, previous) in self.cases[start..start + valid].iter_mut().enumerate() {
+                    let case = cases[l];
+                    changed |= case != *previous;
+                    if case == CROSSING {
+                        crossings += 1;
+                        crossing_point = start + l;
+                    }
+                    *previous = case;
+                    let change = forces[l] - rests[l];
+                    for (sum, column) in force_sums.iter_mut().zip(&weights) {
+                        *sum += column[l] * change;
                     }
                 }
                 start += LANES;
-            }
-            // The nodal force change over the points whose force left its rest value.
-            let mut force_sums = [0.0; 4];
-            for i in segment.start..segment.end {
-                let change = self.point_forces[i] - self.rest_forces_n[i];
-                if change == 0.0 {
-                    continue;
-                }
-                for (sum, column) in force_sums.iter_mut().zip(&self.weight_columns) {
-                    *sum += column[i] * change;
-                }
             }
             for (slot, sum) in segment.places.iter().zip(force_sums) {
                 self.slot_forces[*slot] += sum;
@@ -753,17 +754,26 @@ impl NodalContact {
         let m = self.set_count;
         let mut matrix = [[0.0; N]; N];
         let mut delta = [0.0; N];
+        // Δy − Δy_free on S, zero in the padding (which then subtracts zero products).
+        let mut moved = [0.0; N];
+        for ((value, step), free) in moved
+            .iter_mut()
+            .zip(&self.slot_steps[..m])
+            .zip(&self.slot_free[..m])
+        {
+            *value = step - free;
+        }
         for (a, row) in matrix.iter_mut().enumerate() {
             if a >= m {
                 row[a] = 1.0;
                 continue;
             }
-            let inverse = &self.inverse[a * NODE_CAPACITY..a * NODE_CAPACITY + m];
-            row[..m].copy_from_slice(inverse);
-            delta[a] = self.slot_forces[a];
-            for (b, &h) in inverse.iter().enumerate() {
-                delta[a] -= h * (self.slot_steps[b] - self.slot_free[b]);
+            row[..m].copy_from_slice(&self.inverse[a * NODE_CAPACITY..a * NODE_CAPACITY + m]);
+            let mut value = self.slot_forces[a];
+            for (&h, &change) in row.iter().zip(&moved) {
+                value -= h * change;
             }
+            delta[a] = value;
         }
         self.add_stiffnesses(|a, b, value| matrix[a][b] += value);
         ldl_factor_fixed(&mut matrix);
