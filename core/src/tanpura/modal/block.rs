@@ -455,7 +455,7 @@ impl<const N: usize> Active<'_, N> {
         for a in 0..SIZE {
             let row = &block[active[a]];
             for b in 0..=a {
-                matrix[a][b] = roots[a] * row[active[b]] * roots[b];
+                matrix[b][a] = roots[a] * row[active[b]] * roots[b];
             }
             matrix[a][a] += 1.0;
             y[a] = -roots[a] * residual[active[a]];

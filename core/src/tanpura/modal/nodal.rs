@@ -775,7 +775,7 @@ impl NodalContact {
             }
             delta[a] = value;
         }
-        self.add_stiffnesses(|a, b, value| matrix[a][b] += value);
+        self.add_stiffnesses(|a, b, value| matrix[b][a] += value);
         ldl_factor_fixed(&mut matrix);
         ldl_substitute_fixed(&matrix, &mut delta);
         if let Some(c) = crossing {
@@ -832,8 +832,9 @@ impl NodalContact {
         (largest, finished)
     }
 
-    /// Calls `add(a, b, value)` with each segment's `Σ c w_j w_l` at its slots, a ≥ b (the lower
-    /// triangle the LDLᵀ solvers read).
+    /// Calls `add(a, b, value)` with each segment's `Σ c w_j w_l` at its slots, a ≥ b: entry
+    /// (a, b) of the symmetric matrix, which the fixed-lane solver reads in its upper triangle
+    /// and the general one in its lower.
     #[inline(always)]
     fn add_stiffnesses(&self, mut add: impl FnMut(usize, usize, f64)) {
         for (segment, sums) in self.segments[..self.segment_count]

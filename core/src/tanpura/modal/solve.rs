@@ -65,52 +65,62 @@ pub(super) fn ldl_substitute_in_place(factors: &[f64], n: usize, x: &mut [f64]) 
     }
 }
 
-/// [`ldl_solve_in_place`] on a fixed-size matrix (lower triangle used), for a contact set of
-/// exactly `N` points; the compiler unrolls it.
+/// [`ldl_solve_in_place`] on a fixed-size matrix given by its upper triangle (`matrix[b][a]`
+/// holds `A_ab`, a ≥ b: row k is column k of the lower triangle), for a contact set of exactly
+/// `N` points; the compiler unrolls it.
 #[cfg(test)]
 pub(super) fn ldl_solve_fixed<const N: usize>(matrix: &mut [[f64; N]; N], x: &mut [f64; N]) {
     ldl_factor_fixed(matrix);
     ldl_substitute_fixed(matrix, x);
 }
 
-/// The LDLᵀ factorisation of [`ldl_solve_fixed`], written over `matrix`: `L` below the diagonal,
-/// `D` on it.
+/// The LDLᵀ factorisation of [`ldl_solve_fixed`], written over its upper triangle: `L` by
+/// columns (`matrix[k][i] = L_ik`, i > k), `D` on the diagonal. The same products, summed in the
+/// same order, as [`ldl_solve_in_place`]; by columns, each column's update runs over whole rows
+/// of `N` lanes (the lanes above the column are formed and dropped), which the compiler
+/// vectorises where the row-wise sums stay scalar.
 #[inline(always)]
 pub(super) fn ldl_factor_fixed<const N: usize>(matrix: &mut [[f64; N]; N]) {
-    let mut weighted = [0.0; N];
     for j in 0..N {
-        let mut diagonal = matrix[j][j];
-        for k in 0..j {
-            weighted[k] = matrix[j][k] * matrix[k][k];
-            diagonal -= matrix[j][k] * weighted[k];
-        }
-        matrix[j][j] = diagonal;
-        let inverse = 1.0 / diagonal;
-        for i in j + 1..N {
-            let mut value = matrix[i][j];
-            for k in 0..j {
-                value -= matrix[i][k] * weighted[k];
+        let (done, rest) = matrix.split_at_mut(j);
+        let row_j = &mut rest[0];
+        // Column j less Σ_k L_ik (L_jk d_k), k ascending; its lane j is d_j.
+        let mut column = *row_j;
+        for (k, row_k) in done.iter().enumerate() {
+            let weighted = row_k[j] * row_k[k];
+            for (value, &l) in column.iter_mut().zip(row_k) {
+                *value -= l * weighted;
             }
-            matrix[i][j] = value * inverse;
+        }
+        let diagonal = column[j];
+        let inverse = 1.0 / diagonal;
+        row_j[j] = diagonal;
+        for (target, value) in row_j[j + 1..].iter_mut().zip(&column[j + 1..]) {
+            *target = value * inverse;
         }
     }
 }
 
-/// Solves with the factors of [`ldl_factor_fixed`]: `L y = b`, `D z = y`, `Lᵀ x = z`, in place.
+/// Solves with the factors of [`ldl_factor_fixed`]: `L y = b`, `D z = y`, `Lᵀ x = z`, in place,
+/// with the products in [`ldl_substitute_in_place`]'s order.
 #[inline(always)]
 pub(super) fn ldl_substitute_fixed<const N: usize>(factors: &[[f64; N]; N], x: &mut [f64; N]) {
-    for i in 0..N {
-        for k in 0..i {
-            x[i] -= factors[i][k] * x[k];
+    for (k, row) in factors.iter().enumerate() {
+        let solved = x[k];
+        for (i, (value, &l)) in x.iter_mut().zip(row).enumerate() {
+            *value = if i > k { *value - l * solved } else { *value };
         }
     }
-    for i in 0..N {
-        x[i] /= factors[i][i];
+    for (i, value) in x.iter_mut().enumerate() {
+        *value /= factors[i][i];
     }
-    for i in (0..N).rev() {
-        for k in 0..i {
-            x[k] -= factors[i][k] * x[i];
-        }
+    for (k, row) in factors.iter().enumerate().rev() {
+        let (head, later) = x.split_at_mut(k + 1);
+        head[k] = row[k + 1..]
+            .iter()
+            .zip(later.iter())
+            .rev()
+            .fold(head[k], |value, (&l, &solved)| value - l * solved);
     }
 }
 
@@ -537,7 +547,7 @@ mod tests {
                     0.3 / (1 + i + j) as f64
                 };
                 general[i * n + j] = value;
-                small[i][j] = value;
+                small[j][i] = value;
             }
         }
         let rhs = [1.0, -2.0, 0.5, 3.0, -1.5];

@@ -979,7 +979,7 @@ impl ContactStep {
         for a in 0..N {
             let row = &self.block[self.active[a] * stride..];
             for b in 0..=a {
-                matrix[a][b] = self.roots[a] * row[self.active[b]] * self.roots[b];
+                matrix[b][a] = self.roots[a] * row[self.active[b]] * self.roots[b];
             }
             matrix[a][a] += 1.0;
             y[a] = -self.roots[a] * self.residual[self.active[a]];
