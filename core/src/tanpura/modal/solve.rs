@@ -75,10 +75,11 @@ pub(super) fn ldl_solve_fixed<const N: usize>(matrix: &mut [[f64; N]; N], x: &mu
 }
 
 /// The LDLᵀ factorisation of [`ldl_solve_fixed`], written over its upper triangle: `L` by
-/// columns (`matrix[k][i] = L_ik`, i > k), `D` on the diagonal. The same products, summed in the
-/// same order, as [`ldl_solve_in_place`]; by columns, each column's update runs over whole rows
-/// of `N` lanes (the lanes above the column are formed and dropped), which the compiler
-/// vectorises where the row-wise sums stay scalar.
+/// columns (`matrix[k][i] = L_ik`, i > k), `D` on the diagonal. Each entry takes the products of
+/// the row-wise left-looking factorisation, subtracted one by one for k ascending, so the
+/// factors are those of the row-wise loops bit for bit; by columns, each column's update runs
+/// over whole rows of `N` lanes (the lanes above the column are formed and dropped), which the
+/// compiler vectorises where the row-wise sums stay scalar.
 #[inline(always)]
 pub(super) fn ldl_factor_fixed<const N: usize>(matrix: &mut [[f64; N]; N]) {
     for j in 0..N {
@@ -102,7 +103,7 @@ pub(super) fn ldl_factor_fixed<const N: usize>(matrix: &mut [[f64; N]; N]) {
 }
 
 /// Solves with the factors of [`ldl_factor_fixed`]: `L y = b`, `D z = y`, `Lᵀ x = z`, in place,
-/// with the products in [`ldl_substitute_in_place`]'s order.
+/// each entry's products subtracted one by one in the order of the row-wise substitution.
 #[inline(always)]
 pub(super) fn ldl_substitute_fixed<const N: usize>(factors: &[[f64; N]; N], x: &mut [f64; N]) {
     for (k, row) in factors.iter().enumerate() {
