@@ -138,6 +138,8 @@ pub struct NodalContact {
     /// the stencil's nearest interior node); its weights by column.
     stencil_nodes: Vec<[usize; 4]>,
     weight_columns: [Vec<f64>; 4],
+    /// The same weights by point, for the sums over a segment's four places (one register).
+    weight_rows: Vec<[f64; 4]>,
     runs: Vec<Span>,
     run_count: usize,
     /// Per point: the law's ξ and ψ, and the rest force, N.
@@ -166,7 +168,7 @@ pub struct NodalContact {
     /// last evaluation.
     segments: Vec<Span>,
     segment_count: usize,
-    segment_stiffness: Vec<[f64; 10]>,
+    segment_stiffness: Vec<[[f64; 4]; 4]>,
     /// Per slot: the free step, the iterate and the nodal force change.
     slot_free: Vec<f64>,
     slot_steps: Vec<f64>,
@@ -268,6 +270,23 @@ pub(super) fn write_node_row(node: usize, intervals: usize, modes: &ModeSet, row
     }
 }
 
+/// Adds `sums` to `values` at the four `places`: as one slice when they are consecutive, else
+/// one by one in order (a stencil that names a support's node twice); either way each entry
+/// receives its sums in the same order.
+#[inline(always)]
+fn add_at_places(values: &mut [f64], places: [usize; 4], sums: [f64; 4]) {
+    let first = places[0];
+    if places == [first, first + 1, first + 2, first + 3] {
+        for (value, sum) in values[first..first + 4].iter_mut().zip(sums) {
+            *value += sum;
+        }
+    } else {
+        for (place, sum) in places.into_iter().zip(sums) {
+            values[place] += sum;
+        }
+    }
+}
+
 /// A chunk of [`LANES`] values of `values` from `start` (the arrays are padded).
 #[inline(always)]
 fn chunk(values: &[f64], start: usize) -> [f64; LANES] {
@@ -289,6 +308,7 @@ impl NodalContact {
             point_count: 0,
             stencil_nodes: vec![[0; 4]; capacity],
             weight_columns: std::array::from_fn(|_| zeros(padded)),
+            weight_rows: vec![[0.0; 4]; capacity],
             runs: vec![Span::default(); capacity],
             run_count: 0,
             xis: zeros(padded),
@@ -307,7 +327,7 @@ impl NodalContact {
             inverse: zeros(NODE_CAPACITY * NODE_CAPACITY),
             segments: vec![Span::default(); capacity],
             segment_count: 0,
-            segment_stiffness: vec![[0.0; 10]; capacity],
+            segment_stiffness: vec![[[0.0; 4]; 4]; capacity],
             slot_free: zeros(NODE_CAPACITY),
             slot_steps: zeros(NODE_CAPACITY),
             slot_forces: zeros(NODE_CAPACITY),
@@ -395,6 +415,7 @@ impl NodalContact {
                 let support = node == 0 || node >= intervals;
                 self.stencil_nodes[i][j] = local(node);
                 self.weight_columns[j][i] = if support { 0.0 } else { weight };
+                self.weight_rows[i][j] = self.weight_columns[j][i];
             }
             self.xis[i] = points.laws[i].xi;
             self.psis[i] = points.laws[i].psi;
@@ -623,41 +644,39 @@ impl NodalContact {
                     }
                     *previous = case;
                     let change = forces[l] - rests[l];
-                    for (sum, column) in force_sums.iter_mut().zip(&weights) {
-                        *sum += column[l] * change;
+                    for (sum, weight) in force_sums.iter_mut().zip(self.weight_rows[start + l]) {
+                        *sum += weight * change;
                     }
                 }
                 start += LANES;
             }
-            for (slot, sum) in segment.places.iter().zip(force_sums) {
-                self.slot_forces[*slot] += sum;
-            }
+            add_at_places(&mut self.slot_forces, segment.places, force_sums);
         }
         (changed, crossings, crossing_point)
     }
 
-    /// Each segment's `Σ c w_j w_l` over [`PAIRS`] at the last evaluation (only before an
-    /// update: the evaluation that ends the iteration needs none), over the points with c > 0.
+    /// Each segment's `Σ c w_j w_l` at the last evaluation (only before an update: the
+    /// evaluation that ends the iteration needs none), over the points with c > 0, as a whole
+    /// 4 × 4 block (rows of four sums vectorise; [`NodalContact::add_stiffnesses`] reads the
+    /// [`PAIRS`]), each product formed as `(c w_j) w_l`.
     #[inline(always)]
     fn sum_stiffnesses(&mut self) {
         for (segment, total) in self.segments[..self.segment_count]
             .iter()
             .zip(&mut self.segment_stiffness)
         {
-            let mut sums = [0.0; 10];
+            let mut sums = [[0.0; 4]; 4];
             for i in segment.start..segment.end {
                 let stiffness = self.point_stiffnesses[i];
                 if stiffness == 0.0 {
                     continue;
                 }
-                let weights = [
-                    self.weight_columns[0][i],
-                    self.weight_columns[1][i],
-                    self.weight_columns[2][i],
-                    self.weight_columns[3][i],
-                ];
-                for (sum, &(j, k)) in sums.iter_mut().zip(&PAIRS) {
-                    *sum += stiffness * weights[j] * weights[k];
+                let weights = self.weight_rows[i];
+                for (row, &weight) in sums.iter_mut().zip(&weights) {
+                    let scaled = stiffness * weight;
+                    for (sum, &other) in row.iter_mut().zip(&weights) {
+                        *sum += scaled * other;
+                    }
                 }
             }
             *total = sums;
@@ -775,7 +794,7 @@ impl NodalContact {
             }
             delta[a] = value;
         }
-        self.add_stiffnesses(|a, b, value| matrix[b][a] += value);
+        self.add_stiffnesses_fixed(&mut matrix);
         ldl_factor_fixed(&mut matrix);
         ldl_substitute_fixed(&matrix, &mut delta);
         if let Some(c) = crossing {
@@ -832,6 +851,34 @@ impl NodalContact {
         (largest, finished)
     }
 
+    /// Adds each segment's `Σ c w_j w_l` to a fixed-lane matrix (upper triangle: `matrix[b][a]`,
+    /// a ≥ b). A segment whose places are four consecutive slots adds its whole 4 × 4 block row
+    /// by row (vector adds; the entries below the diagonal are never read by
+    /// [`ldl_factor_fixed`] nor [`ldl_substitute_fixed`]); one whose stencil names a node twice
+    /// (a support's entry) adds its pairs one by one. Every entry that is read receives the same
+    /// sums in the same order as through [`NodalContact::add_stiffnesses`].
+    #[inline(always)]
+    fn add_stiffnesses_fixed<const N: usize>(&self, matrix: &mut [[f64; N]; N]) {
+        for (segment, sums) in self.segments[..self.segment_count]
+            .iter()
+            .zip(&self.segment_stiffness)
+        {
+            let first = segment.places[0];
+            if segment.places == [first, first + 1, first + 2, first + 3] && first + 4 <= N {
+                for (row, row_sums) in matrix[first..first + 4].iter_mut().zip(sums) {
+                    for (value, sum) in row[first..first + 4].iter_mut().zip(row_sums) {
+                        *value += sum;
+                    }
+                }
+            } else {
+                for &(j, k) in &PAIRS {
+                    let (a, b) = (segment.places[j], segment.places[k]);
+                    matrix[a.min(b)][a.max(b)] += sums[j][k];
+                }
+            }
+        }
+    }
+
     /// Calls `add(a, b, value)` with each segment's `Σ c w_j w_l` at its slots, a ≥ b: entry
     /// (a, b) of the symmetric matrix, which the fixed-lane solver reads in its upper triangle
     /// and the general one in its lower.
@@ -841,9 +888,9 @@ impl NodalContact {
             .iter()
             .zip(&self.segment_stiffness)
         {
-            for (&(j, k), &value) in PAIRS.iter().zip(sums) {
+            for &(j, k) in &PAIRS {
                 let (a, b) = (segment.places[j], segment.places[k]);
-                add(a.max(b), a.min(b), value);
+                add(a.max(b), a.min(b), sums[j][k]);
             }
         }
     }
@@ -1068,5 +1115,64 @@ mod tests {
             );
             assert_eq!(named, case, "{gap} {step}");
         }
+    }
+
+    /// The fixed-lane matrix gets each segment's block as the pair-by-pair scatter gives it,
+    /// bit for bit on every entry the factorisation reads (the upper triangle): four consecutive
+    /// places by rows, a stencil that names a support's node twice pair by pair, at the edge of
+    /// the lanes too; and the slots' force sums likewise.
+    #[test]
+    fn whole_row_scatter_is_the_pairwise_scatter() {
+        let mut contact = NodalContact::new(8);
+        let places = [
+            [0, 1, 2, 3],
+            [1, 2, 3, 4],
+            [0, 0, 1, 2],
+            [4, 5, 6, 7],
+            [5, 6, 7, 7],
+        ];
+        contact.segment_count = places.len();
+        for (s, places) in places.into_iter().enumerate() {
+            contact.segments[s] = Span {
+                start: s,
+                end: s + 1,
+                places,
+            };
+            // Weights of a cubic stencil with the point's own offset, c of the point's own size.
+            let offset = 0.1 + 0.17 * s as f64;
+            let weights = [
+                -offset * (1.0 - offset) * (2.0 - offset) / 6.0,
+                (1.0 + offset) * (1.0 - offset) * (2.0 - offset) / 2.0,
+                (1.0 + offset) * offset * (2.0 - offset) / 2.0,
+                -(1.0 + offset) * offset * (1.0 - offset) / 6.0,
+            ];
+            let stiffness = 1.3e5 * (1.0 + s as f64);
+            contact.segment_stiffness[s] =
+                weights.map(|w_j| weights.map(|w_l| stiffness * w_j * w_l));
+        }
+        let start: [[f64; 8]; 8] =
+            std::array::from_fn(|b| std::array::from_fn(|a| 1.0 / (1.0 + a as f64 + b as f64)));
+        let (mut by_rows, mut by_pairs) = (start, start);
+        contact.add_stiffnesses_fixed(&mut by_rows);
+        contact.add_stiffnesses(|a, b, value| by_pairs[b][a] += value);
+        for b in 0..8 {
+            for a in b..8 {
+                assert_eq!(
+                    by_rows[b][a].to_bits(),
+                    by_pairs[b][a].to_bits(),
+                    "({a}, {b})"
+                );
+            }
+        }
+        let mut sliced = [0.25; 8];
+        let mut one_by_one = sliced;
+        for (s, places) in places.into_iter().enumerate() {
+            let sums = [1.0, -2.0, 3.0, -4.0].map(|v| v / (3.0 + s as f64));
+            add_at_places(&mut sliced, places, sums);
+            for (place, sum) in places.into_iter().zip(sums) {
+                one_by_one[place] += sum;
+            }
+        }
+        assert_eq!(sliced.map(f64::to_bits), one_by_one.map(f64::to_bits));
     }
 }
