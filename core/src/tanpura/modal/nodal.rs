@@ -30,8 +30,10 @@
 //!
 //! **Which points Newton sees.** Those within the tracking band of contact, or loaded at rest,
 //! as in section 4. After Newton every point's step is formed from the nodes in one pass over
-//! runs of points that share a stencil (plain arrays the compiler vectorises); if an untracked
-//! point would touch, it joins and the solve is redone before anything moves. The tracked points
+//! groups of [`LANES`] points, each summing its band of nodes' steps in order with the weights
+//! its points put on them (zeros off a point's stencil, so each sum is the stencil's four
+//! products); whether an untracked point touches or comes near is read off each lane's largest
+//! gap. If one would touch, it joins and the solve is redone before anything moves. The tracked points
 //! are evaluated in chunks of [`LANES`] with a branch-free copy of the contact law; H is formed
 //! again only when the node set S changes, not with every point that joins or leaves; up to 8
 //! and 16 nodes the update is solved in fixed lanes.
@@ -110,6 +112,15 @@ fn append_to_spans(spans: &mut [Span], count: &mut usize, i: usize, places: [usi
     *count += 1;
 }
 
+/// A group of [`LANES`] points' band of nodes: the first node, how many, and where its weight
+/// rows start.
+#[derive(Debug, Clone, Copy, Default)]
+struct GroupBand {
+    first_node: usize,
+    nodes: usize,
+    offset: usize,
+}
+
 /// What one step's contact work reports.
 #[derive(Debug, Clone, Copy)]
 pub struct NodalOutcome {
@@ -140,8 +151,12 @@ pub struct NodalContact {
     weight_columns: [Vec<f64>; 4],
     /// The same weights by point, for the sums over a segment's four places (one register).
     weight_rows: Vec<[f64; 4]>,
-    runs: Vec<Span>,
-    run_count: usize,
+    /// The points in groups of [`LANES`] (the last padded): each group's weights on the band of
+    /// nodes its stencils reach, one row of lanes per node (`group_weights`, from `offset`), and
+    /// the band's first node and length.
+    group_bands: Vec<GroupBand>,
+    group_count: usize,
+    group_weights: Vec<[f64; LANES]>,
     /// Per point: the law's ξ and ψ, and the rest force, N.
     xis: Vec<f64>,
     psis: Vec<f64>,
@@ -309,14 +324,15 @@ impl NodalContact {
             stencil_nodes: vec![[0; 4]; capacity],
             weight_columns: std::array::from_fn(|_| zeros(padded)),
             weight_rows: vec![[0.0; 4]; capacity],
-            runs: vec![Span::default(); capacity],
-            run_count: 0,
+            group_bands: vec![GroupBand::default(); capacity.div_ceil(LANES)],
+            group_count: 0,
+            group_weights: vec![[0.0; LANES]; capacity.div_ceil(LANES) * NODE_CAPACITY],
             xis: zeros(padded),
             psis: zeros(padded),
             rest_forces_n: zeros(padded),
             gaps_m: zeros(padded),
             next_gaps_m: zeros(padded),
-            far_offsets_m: zeros(capacity),
+            far_offsets_m: zeros(padded),
             tracked: vec![0; capacity],
             tracked_count: 0,
             set_changed: true,
@@ -421,15 +437,40 @@ impl NodalContact {
             self.psis[i] = points.laws[i].psi;
             self.rest_forces_n[i] = points.rest_forces_n[i];
         }
-        self.run_count = 0;
-        for i in 0..count {
-            append_to_spans(
-                &mut self.runs,
-                &mut self.run_count,
-                i,
-                self.stencil_nodes[i],
-            );
+        // The groups' bands (a point's stencil nodes do not decrease with j), each node's row
+        // the sum of the weights the group's points put on it (a support's entry adds zero).
+        self.group_count = count.div_ceil(LANES);
+        let mut offset = 0;
+        for group in 0..self.group_count {
+            let points = group * LANES..((group + 1) * LANES).min(count);
+            let first_node = points
+                .clone()
+                .map(|i| self.stencil_nodes[i][0])
+                .min()
+                .unwrap_or(0);
+            let last_node = points
+                .clone()
+                .map(|i| self.stencil_nodes[i][3])
+                .max()
+                .unwrap_or(0);
+            let nodes = last_node + 1 - first_node;
+            let rows = &mut self.group_weights[offset..offset + nodes];
+            rows.fill([0.0; LANES]);
+            for i in points {
+                for j in 0..4 {
+                    rows[self.stencil_nodes[i][j] - first_node][i - group * LANES] +=
+                        self.weight_columns[j][i];
+                }
+            }
+            self.group_bands[group] = GroupBand {
+                first_node,
+                nodes,
+                offset,
+            };
+            offset += nodes;
         }
+        // The padding lanes never touch.
+        self.far_offsets_m[count..].fill(f64::NEG_INFINITY);
         // V and G_N = V diag(b) Vᵀ.
         let modes_count = modes.count();
         for (j, &node) in self.grid_nodes[..node_count].iter().enumerate() {
@@ -954,33 +995,34 @@ impl NodalContact {
             }
             // Every point's gap after the step; whether an untracked one would touch, and
             // whether one then lies within the band.
-            let (mut touches, mut near) = (false, false);
-            for run in &self.runs[..self.run_count] {
-                let y = run.places.map(|node| self.node_steps_m[node]);
-                let range = run.start..run.end;
-                let columns = [
-                    &self.weight_columns[0][range.clone()],
-                    &self.weight_columns[1][range.clone()],
-                    &self.weight_columns[2][range.clone()],
-                    &self.weight_columns[3][range.clone()],
-                ];
-                let inputs = self.gaps_m[range.clone()]
-                    .iter()
-                    .zip(&self.far_offsets_m[range.clone()]);
-                for (k, (next, (&gap, &offset))) in self.next_gaps_m[range.clone()]
-                    .iter_mut()
-                    .zip(inputs)
-                    .enumerate()
-                {
-                    let step = columns[0][k] * y[0]
-                        + columns[1][k] * y[1]
-                        + columns[2][k] * y[2]
-                        + columns[3][k] * y[3];
-                    *next = gap - step;
-                    touches |= *next + offset > 0.0;
-                    near |= *next + offset > -band_m;
+            // Each lane's largest `a_i` among the untracked points (the tracked ones' offset is
+            // −∞): one of them touches if it is positive, lies within the band if above −band.
+            let mut reach = [f64::NEG_INFINITY; LANES];
+            for (group, band) in self.group_bands[..self.group_count].iter().enumerate() {
+                let start = group * LANES;
+                // Each point's step summed over the band's nodes in order: the zero weights
+                // add exact zeros, so the sum is its stencil's four products, left to right.
+                let mut steps = [0.0; LANES];
+                let rows = &self.group_weights[band.offset..band.offset + band.nodes];
+                let nodes = &self.node_steps_m[band.first_node..band.first_node + band.nodes];
+                for (row, &y) in rows.iter().zip(nodes) {
+                    for (step, &weight) in steps.iter_mut().zip(row) {
+                        *step += weight * y;
+                    }
                 }
+                let (gaps, offsets) = (
+                    chunk(&self.gaps_m, start),
+                    chunk(&self.far_offsets_m, start),
+                );
+                let mut next = [0.0; LANES];
+                for l in 0..LANES {
+                    next[l] = gaps[l] - steps[l];
+                    reach[l] = reach[l].max(next[l] + offsets[l]);
+                }
+                self.next_gaps_m[start..start + LANES].copy_from_slice(&next);
             }
+            let touches = reach.iter().any(|&r| r > 0.0);
+            let near = reach.iter().any(|&r| r > -band_m);
             self.far_point_near = near;
             if !touches {
                 break;
