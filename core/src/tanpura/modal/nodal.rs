@@ -33,10 +33,10 @@
 //! groups of [`LANES`] points, each summing its band of nodes' steps in order with the weights
 //! its points put on them (zeros off a point's stencil, so each sum is the stencil's four
 //! products); whether an untracked point touches or comes near is read off each lane's largest
-//! gap. If one would touch, it joins and the solve is redone before anything moves. The tracked points
-//! are evaluated in chunks of [`LANES`] with a branch-free copy of the contact law; H is formed
-//! again only when the node set S changes, not with every point that joins or leaves; up to 8
-//! and 16 nodes the update is solved in fixed lanes.
+//! gap. If one would touch, it joins and the solve is redone before anything moves. The tracked
+//! points are evaluated in chunks of [`LANES`] with a branch-free copy of the contact law; H is
+//! formed again only when the node set S changes, not with every point that joins or leaves; up
+//! to 8 and 16 nodes the update is solved in fixed lanes.
 //!
 //! Hand-written rather than on a linear-algebra crate: the systems have at most
 //! [`NODE_CAPACITY`] unknowns and are solved once or twice per sample on the audio thread;
@@ -894,10 +894,11 @@ impl NodalContact {
 
     /// Adds each segment's `Σ c w_j w_l` to a fixed-lane matrix (upper triangle: `matrix[b][a]`,
     /// a ≥ b). A segment whose places are four consecutive slots adds its whole 4 × 4 block row
-    /// by row (vector adds; the entries below the diagonal are never read by
-    /// [`ldl_factor_fixed`] nor [`ldl_substitute_fixed`]); one whose stencil names a node twice
-    /// (a support's entry) adds its pairs one by one. Every entry that is read receives the same
-    /// sums in the same order as through [`NodalContact::add_stiffnesses`].
+    /// by row (vector adds; the entries below the diagonal that this fills never reach the
+    /// factors or the solution: [`ldl_factor_fixed`] forms those lanes and drops them, and
+    /// [`ldl_substitute_fixed`] selects them away); one whose stencil names a node twice (a
+    /// support's entry) adds its pairs one by one. Every other entry receives the same sums in
+    /// the same order as through [`NodalContact::add_stiffnesses`].
     #[inline(always)]
     fn add_stiffnesses_fixed<const N: usize>(&self, matrix: &mut [[f64; N]; N]) {
         for (segment, sums) in self.segments[..self.segment_count]
