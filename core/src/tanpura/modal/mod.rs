@@ -1657,6 +1657,78 @@ mod tests {
         assert!(lane_stats.iterations > lane_stats.steps, "{lane_stats:?}");
     }
 
+    /// A step whose evaluation finds several points crossing the contact's edge is finished by
+    /// Newton on their steps alone (`NodalContact::solve_crossings`), and the finish is the
+    /// solution Newton's iteration on S converges to: over a pluck and a harder one on the
+    /// fine tier's points, the pickups lie within 1e-10 of their range of those of the iteration
+    /// run to 1e-17 m, and the finish takes less than two thirds of the updates the iteration
+    /// takes at the tier's tolerance (1e-12 m).
+    #[test]
+    fn several_crossings_finish_where_newtons_iteration_converges() {
+        let run = |iterate: bool, tolerance_m: f64| {
+            let mut string = ModalString::<f64>::new(ModalStringConfig {
+                bridge_point_spacing_m: 0.36e-3,
+                thread_point_spacing_m: 0.2e-3,
+                grid_modes: Some(GridModes {
+                    intervals: 200,
+                    time_step_s: 1.0 / (4.0 * 44_100.0),
+                    condensed: true,
+                }),
+                newton: NewtonSettings {
+                    tolerance_m,
+                    max_iterations: 30,
+                },
+                ..ModalStringConfig::REFERENCE
+            });
+            assert!(string.nodal_in_use);
+            if iterate {
+                string.nodal.iterate_over_crossings();
+            }
+            let mut output = Vec::new();
+            for amplitude_m in [2e-3, 4e-3] {
+                string.pluck(&Pluck {
+                    amplitude_m,
+                    ..Pluck::default()
+                });
+                for _ in 0..8820 {
+                    string.step();
+                    output.push([string.nut_force_n(), string.bridge_force_n()]);
+                }
+            }
+            (output, *string.newton_stats())
+        };
+        let (finished, finished_stats) = run(false, 1e-12);
+        let (converged, converged_stats) = run(true, 1e-17);
+        let (_, iterated_stats) = run(true, 1e-12);
+        assert_eq!(converged_stats.cap_hits, 0, "{converged_stats:?}");
+        assert_eq!(finished_stats.cap_hits, 0, "{finished_stats:?}");
+        for pickup in 0..2 {
+            let range = converged
+                .iter()
+                .map(|f| f[pickup].abs())
+                .fold(0.0, f64::max);
+            let worst = finished
+                .iter()
+                .zip(&converged)
+                .map(|(a, b)| (a[pickup] - b[pickup]).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                worst <= 1e-10 * range,
+                "pickup {pickup}: {worst:e} of {range:e}"
+            );
+        }
+        eprintln!(
+            "updates per step: finished {:.3}, iterated {:.3}, converged {:.3}",
+            finished_stats.mean_iterations(),
+            iterated_stats.mean_iterations(),
+            converged_stats.mean_iterations()
+        );
+        assert!(
+            3 * finished_stats.iterations < 2 * iterated_stats.iterations,
+            "{finished_stats:?} against {iterated_stats:?}"
+        );
+    }
+
     /// The static problems solved on the nodes (`nodal_statics.rs`) are the point-level ones
     /// (`solve.rs`) up to round-off, on the tier's spacings and the reference's, at a crest key
     /// and above it: the rest state (every point's rest force, the modal rest state), the

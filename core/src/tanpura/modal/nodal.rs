@@ -63,6 +63,11 @@ const _: () = assert!(
     "the node rows are dotted in fours"
 );
 const UNSET: usize = usize::MAX;
+/// Up to this many points crossing the contact's edge in one update, the step is finished by
+/// Newton on their steps alone ([`NodalContact::solve_crossings`]).
+const MOST_CROSSINGS: usize = 8;
+/// The most updates of that small Newton iteration (it takes 1–5 on the bench's string).
+const CROSSING_ITERATION_CAP: usize = 16;
 /// The points are evaluated in chunks of this many lanes (loops over fixed arrays that the
 /// compiler vectorises); the per-point arrays are padded by as many.
 const LANES: usize = 8;
@@ -198,6 +203,8 @@ pub struct NodalContact {
     point_forces: Vec<f64>,
     point_stiffnesses: Vec<f64>,
     cases: Vec<f64>,
+    /// The points crossing at the last evaluation (the first [`MOST_CROSSINGS`] of them).
+    crossing_points: [usize; MOST_CROSSINGS],
     matrix: Vec<f64>,
     right_side: Vec<f64>,
     scratch: Vec<f64>,
@@ -213,6 +220,10 @@ pub struct NodalContact {
     /// Whether every update takes the general path (for the test that the paths agree).
     #[cfg(test)]
     general_path_only: bool,
+    /// Whether steps with several crossing points are left to Newton's iteration on S (for
+    /// the test that their finish is the iteration's solution).
+    #[cfg(test)]
+    iterate_over_crossings: bool,
 }
 
 /// The mid-point force of `contact.rs` (`HuntCrossley::midpoint_force_linear_damping`) for a
@@ -354,6 +365,7 @@ impl NodalContact {
             point_forces: zeros(padded),
             point_stiffnesses: zeros(padded),
             cases: vec![OUT; padded],
+            crossing_points: [UNSET; MOST_CROSSINGS],
             matrix: zeros(NODE_CAPACITY * NODE_CAPACITY),
             right_side: zeros(NODE_CAPACITY),
             scratch: zeros(NODE_CAPACITY),
@@ -365,6 +377,8 @@ impl NodalContact {
             far_point_near: false,
             #[cfg(test)]
             general_path_only: false,
+            #[cfg(test)]
+            iterate_over_crossings: false,
         }
     }
 
@@ -372,6 +386,13 @@ impl NodalContact {
     #[cfg(test)]
     pub(super) fn take_general_path_only(&mut self) {
         self.general_path_only = true;
+    }
+
+    /// Leaves steps with several crossing points to Newton's iteration on S (the test that
+    /// their finish is the iteration's solution).
+    #[cfg(test)]
+    pub(super) fn iterate_over_crossings(&mut self) {
+        self.iterate_over_crossings = true;
     }
 
     /// How many nodes the points reach (0: not configured).
@@ -632,13 +653,13 @@ impl NodalContact {
     }
 
     /// Every tracked point's step, force, c and case at the iterate on S, in chunks of
-    /// [`LANES`], and the nodal force change on S. Returns whether a
-    /// point's case changed since the last evaluation, how many points cross, and the last of
-    /// them.
+    /// [`LANES`], and the nodal force change on S; the crossing points in `crossing_points`.
+    /// Returns whether a point's case changed since the last evaluation, whether one of them
+    /// had been in a linear case (in or out), and how many points cross.
     #[inline(always)]
-    fn evaluate(&mut self) -> (bool, usize, usize) {
+    fn evaluate(&mut self) -> (bool, bool, usize) {
         self.slot_forces[..self.set_count].fill(0.0);
-        let (mut changed, mut crossings, mut crossing_point) = (false, 0, UNSET);
+        let (mut changed, mut left_linear, mut crossings) = (false, false, 0);
         for index in 0..self.segment_count {
             let segment = self.segments[index];
             let y = segment.places.map(|slot| self.slot_steps[slot]);
@@ -679,9 +700,12 @@ impl NodalContact {
                 for (l, previous) in self.cases[start..start + valid].iter_mut().enumerate() {
                     let case = cases[l];
                     changed |= case != *previous;
+                    left_linear |= case != *previous && *previous != CROSSING;
                     if case == CROSSING {
+                        if crossings < MOST_CROSSINGS {
+                            self.crossing_points[crossings] = start + l;
+                        }
                         crossings += 1;
-                        crossing_point = start + l;
                     }
                     *previous = case;
                     let change = forces[l] - rests[l];
@@ -693,7 +717,7 @@ impl NodalContact {
             }
             add_at_places(&mut self.slot_forces, segment.places, force_sums);
         }
-        (changed, crossings, crossing_point)
+        (changed, left_linear, crossings)
     }
 
     /// Each segment's `Σ c w_j w_l` at the last evaluation (only before an update: the
@@ -727,7 +751,7 @@ impl NodalContact {
     /// Newton's iteration on S from the iterate in `slot_steps`. Returns (updates, converged).
     #[inline(always)]
     fn newton(&mut self, settings: &NewtonSettings) -> (u32, bool) {
-        let (_, mut crossings, mut crossing_point) = self.evaluate();
+        let (_, _, mut crossings) = self.evaluate();
         let mut updates = 0;
         loop {
             if updates >= settings.max_iterations {
@@ -742,21 +766,23 @@ impl NodalContact {
             };
             #[cfg(not(test))]
             let size = self.set_count;
-            // One point crossing the contact's edge and every other in a linear case: the
-            // update finishes the step exactly (`NodalContact::exact_departure`).
-            let crossing = (crossings == 1).then_some(crossing_point);
+            // A few points crossing the contact's edge and every other in a linear case: the
+            // update finishes the step (`NodalContact::exact_departure`,
+            // `NodalContact::solve_crossings`).
+            let tolerance_m = settings.tolerance_m;
             let (largest, finished) = match size {
-                0..=8 => self.update_in_lanes::<8>(crossing),
-                9..=16 => self.update_in_lanes::<16>(crossing),
-                _ => self.update_general(crossing),
+                0..=8 => self.update_in_lanes::<8>(crossings, tolerance_m),
+                9..=16 => self.update_in_lanes::<16>(crossings, tolerance_m),
+                _ => self.update_general(crossings, tolerance_m),
             };
             updates += 1;
-            let changed;
-            (changed, crossings, crossing_point) = self.evaluate();
-            // An exact finish stands if every point kept the case it was solved in.
+            let (changed, left_linear);
+            (changed, left_linear, crossings) = self.evaluate();
+            // A finish stands if every point that was in a linear case kept it: the crossing
+            // points' law was solved whole, in whichever case each ends.
             if !(changed || crossings > 0)
                 || largest <= settings.tolerance_m
-                || (finished && !changed)
+                || (finished && !left_linear)
             {
                 return (updates, true);
             }
@@ -772,6 +798,14 @@ impl NodalContact {
         }
     }
 
+    /// `l_c · values` for point `c`: its stencil's four weights on the slots of S.
+    #[inline(always)]
+    fn along(&self, c: usize, values: &[f64]) -> f64 {
+        (0..4)
+            .map(|j| self.weight_columns[j][c] * values[self.node_slots[self.stencil_nodes[c][j]]])
+            .sum()
+    }
+
     /// The exact finish of a step whose one crossing point is `c` (section 4, in the nodes):
     /// with every other point in a linear case the scheme's equations are
     /// `A (Δy − Δy⁰) = ρ_N + l_c ρ(s_c)`, `A = H + Σ c l lᵀ` at the evaluation, where `ρ(s)` is
@@ -781,13 +815,6 @@ impl NodalContact {
     /// [`exact_crossing_step`]). Returns ρ at its root, or `None` where neither case holds one.
     #[inline(always)]
     fn exact_departure(&self, c: usize, delta: &[f64], direction: &[f64]) -> Option<f64> {
-        let along = |values: &[f64]| -> f64 {
-            (0..4)
-                .map(|j| {
-                    self.weight_columns[j][c] * values[self.node_slots[self.stencil_nodes[c][j]]]
-                })
-                .sum()
-        };
         exact_crossing_step(CrossingPoint {
             gap: self.gaps_m[c],
             start: self.point_steps[c],
@@ -797,20 +824,195 @@ impl NodalContact {
             },
             force: self.point_forces[c],
             stiffness: self.point_stiffnesses[c],
-            direction: along(direction),
-            delta: along(delta),
+            direction: self.along(c, direction),
+            delta: self.along(c, delta),
         })
         .map(|(_, departure)| departure)
         .filter(|departure| departure.is_finite())
     }
 
+    /// Finishes the step whose evaluation found `crossings` points crossing (the rest in a
+    /// linear case), given Newton's update `delta` (`m` = |S| entries, zeros after them) and
+    /// `substitute`, which solves `A x = b` in place with the update's factors: one point by
+    /// [`NodalContact::exact_departure`], two to [`MOST_CROSSINGS`] by
+    /// [`NodalContact::solve_crossings`] (in as many lanes, up to six; in eight for seven or
+    /// eight). Returns whether it did; `delta` then holds the finished update.
+    #[inline(always)]
+    fn finish_step<const N: usize>(
+        &self,
+        substitute: impl Fn(&mut [f64; N]),
+        delta: &mut [f64; N],
+        crossings: usize,
+        tolerance_m: f64,
+    ) -> bool {
+        let m = self.set_count;
+        if crossings == 1 {
+            let c = self.crossing_points[0];
+            let mut direction = [0.0; N];
+            self.crossing_column(c, &mut direction[..m]);
+            substitute(&mut direction);
+            let Some(departure) = self.exact_departure(c, &delta[..m], &direction[..m]) else {
+                return false;
+            };
+            for (d, w) in delta[..m].iter_mut().zip(&direction[..m]) {
+                *d += departure * w;
+            }
+            return true;
+        }
+        #[cfg(test)]
+        if self.iterate_over_crossings {
+            return false;
+        }
+        match crossings {
+            2 => self.solve_crossings::<N, 2>(&substitute, delta, 2, tolerance_m),
+            3 => self.solve_crossings::<N, 3>(&substitute, delta, 3, tolerance_m),
+            4 => self.solve_crossings::<N, 4>(&substitute, delta, 4, tolerance_m),
+            5 => self.solve_crossings::<N, 5>(&substitute, delta, 5, tolerance_m),
+            6 => self.solve_crossings::<N, 6>(&substitute, delta, 6, tolerance_m),
+            7..=MOST_CROSSINGS => self.solve_crossings::<N, MOST_CROSSINGS>(
+                &substitute,
+                delta,
+                crossings,
+                tolerance_m,
+            ),
+            _ => false,
+        }
+    }
+
+    /// The finish of a step whose `k ≥ 2` crossing points are `crossing_points[..k]`, in
+    /// `K ≥ k` lanes (`docs/modal-tanpura.md`, section 11): with every other point in a linear
+    /// case, `A (Δy − Δy⁰) = ρ_N + Σ_d l_d ρ_d(s_d)`, so `Δy = Δy⁰ + δ + Σ_d ρ_d w_d` with
+    /// `w_d = A⁻¹ l_d`, and the k crossing points' steps solve
+    ///
+    /// `s_c = ŝ_c + Σ_d W_cd ρ_d(s_d)`,   `ŝ_c = s⁰_c + l_c·δ`,   `W_cd = l_c·w_d`,
+    ///
+    /// where `ρ_d(s) = F_d(s) − F⁰_d + c⁰_d (s − s⁰_d)` is point d's law (in whichever case s puts
+    /// it) less its tangent at the evaluation. Newton on these k unknowns from ŝ (Newton's own
+    /// point): the Jacobian is `I − W diag(c⁰ − c(s))`, whose leading minors are positive (W is
+    /// a principal block of `Lᵀ A⁻¹ L` with `A ⪰ H + L diag(c⁰) Lᵀ`, H positive definite, and
+    /// c(s) ≥ 0), so Gaussian elimination needs no pivoting; a pivot that is not positive ends
+    /// the finish. It stops when its update is at most `tolerance_m`, at most
+    /// [`CROSSING_ITERATION_CAP`] updates, and the lanes past k hold the identity. Returns
+    /// whether it converged; `delta` then holds `δ + Σ_d ρ_d w_d`.
+    ///
+    /// Each iteration costs O(K³) on a few registers, against an update on S (the evaluation
+    /// of every tracked point, the stiffness sums and the factorisation) that it replaces.
+    #[inline(always)]
+    fn solve_crossings<const N: usize, const K: usize>(
+        &self,
+        substitute: &impl Fn(&mut [f64; N]),
+        delta: &mut [f64; N],
+        k: usize,
+        tolerance_m: f64,
+    ) -> bool {
+        let m = self.set_count;
+        let points = &self.crossing_points[..k];
+        // Each point's l_d on S, and w_d = A⁻¹ l_d.
+        let mut columns = [[0.0; N]; K];
+        let mut directions = [[0.0; N]; K];
+        for ((column, direction), &point) in columns.iter_mut().zip(&mut directions).zip(points) {
+            self.crossing_column(point, &mut column[..m]);
+            *direction = *column;
+            substitute(direction);
+        }
+        let dot = |a: &[f64; N], b: &[f64; N]| -> f64 { a.iter().zip(b).map(|(x, y)| x * y).sum() };
+        let mut coupling = [[0.0; K]; K];
+        let mut newton_steps = [0.0; K];
+        for (c, &point) in points.iter().enumerate() {
+            for d in c..k {
+                let value = dot(&columns[c], &directions[d]);
+                coupling[c][d] = value;
+                coupling[d][c] = value;
+            }
+            newton_steps[c] = self.point_steps[point] + dot(&columns[c], delta);
+        }
+        let mut steps = newton_steps;
+        let mut departures = [0.0; K];
+        let mut converged = false;
+        for _ in 0..=CROSSING_ITERATION_CAP {
+            // Each point's departure at its step, and its slope c⁰ − c(s).
+            let mut slopes = [0.0; K];
+            for (d, &point) in points.iter().enumerate() {
+                let (force, stiffness, _) = law_lane(
+                    self.gaps_m[point],
+                    steps[d],
+                    self.xis[point],
+                    self.psis[point],
+                );
+                let tangent = self.point_stiffnesses[point];
+                departures[d] = force - self.point_forces[point]
+                    + tangent * (steps[d] - self.point_steps[point]);
+                slopes[d] = tangent - stiffness;
+            }
+            if converged {
+                break;
+            }
+            // The residual and the Jacobian; the padding lanes solve x = 0.
+            let mut jacobian = [[0.0; K]; K];
+            let mut residual = [0.0; K];
+            for c in 0..K {
+                let mut value = steps[c] - newton_steps[c];
+                for d in 0..K {
+                    value -= coupling[c][d] * departures[d];
+                    jacobian[c][d] = -coupling[c][d] * slopes[d];
+                }
+                jacobian[c][c] += 1.0;
+                residual[c] = value;
+            }
+            let mut smallest_pivot = f64::INFINITY;
+            for column in 0..K {
+                let pivot = jacobian[column][column];
+                smallest_pivot = smallest_pivot.min(pivot);
+                let inverse = 1.0 / pivot;
+                for row in column + 1..K {
+                    let factor = jacobian[row][column] * inverse;
+                    for entry in column + 1..K {
+                        jacobian[row][entry] -= factor * jacobian[column][entry];
+                    }
+                    residual[row] -= factor * residual[column];
+                }
+            }
+            // Also ends it on a NaN pivot.
+            if smallest_pivot.is_nan() || smallest_pivot <= 0.0 {
+                return false;
+            }
+            let mut largest = 0.0f64;
+            for row in (0..K).rev() {
+                let mut value = residual[row];
+                for entry in row + 1..K {
+                    value -= jacobian[row][entry] * residual[entry];
+                }
+                residual[row] = value / jacobian[row][row];
+                steps[row] -= residual[row];
+                largest = largest.max(residual[row].abs());
+            }
+            if !largest.is_finite() {
+                return false;
+            }
+            converged = largest <= tolerance_m;
+        }
+        if !converged || departures.iter().any(|departure| !departure.is_finite()) {
+            return false;
+        }
+        for (departure, direction) in departures.iter().zip(&directions) {
+            for (value, &w) in delta[..m].iter_mut().zip(direction) {
+                *value += departure * w;
+            }
+        }
+        true
+    }
+
     /// One update (N1), `(H + Σ c l lᵀ) δ = f − H (Δy − Δy_free)`, applied to the iterate, in
     /// `N ≥ |S|` fixed lanes padded with the identity (the padding solves δ = 0). Up to 8 and up
-    /// to 16 nodes (every step of the bench's scenes). Returns max|δ|.
-    /// With `crossing`, the step is finished exactly where it can be
-    /// ([`NodalContact::exact_departure`]); returns whether it was.
+    /// to 16 nodes (every step of the bench's scenes). Returns max|δ|, and whether the step was
+    /// finished where its evaluation found `crossings` points crossing
+    /// ([`NodalContact::finish_step`]).
     #[inline(always)]
-    fn update_in_lanes<const N: usize>(&mut self, crossing: Option<usize>) -> (f64, bool) {
+    fn update_in_lanes<const N: usize>(
+        &mut self,
+        crossings: usize,
+        tolerance_m: f64,
+    ) -> (f64, bool) {
         let m = self.set_count;
         let mut matrix = [[0.0; N]; N];
         let mut delta = [0.0; N];
@@ -838,22 +1040,18 @@ impl NodalContact {
         self.add_stiffnesses_fixed(&mut matrix);
         ldl_factor_fixed(&mut matrix);
         ldl_substitute_fixed(&matrix, &mut delta);
-        if let Some(c) = crossing {
-            let mut direction = [0.0; N];
-            self.crossing_column(c, &mut direction[..m]);
-            ldl_substitute_fixed(&matrix, &mut direction);
-            if let Some(departure) = self.exact_departure(c, &delta, &direction) {
-                for (d, w) in delta[..m].iter_mut().zip(&direction) {
-                    *d += departure * w;
-                }
-                return (self.apply_update(&delta[..m]), true);
-            }
-        }
-        (self.apply_update(&delta[..m]), false)
+        let finished = crossings > 0
+            && self.finish_step(
+                |x: &mut [f64; N]| ldl_substitute_fixed(&matrix, x),
+                &mut delta,
+                crossings,
+                tolerance_m,
+            );
+        (self.apply_update(&delta[..m]), finished)
     }
 
     /// [`NodalContact::update_in_lanes`] on any number of nodes (stride m, lower triangle).
-    fn update_general(&mut self, crossing: Option<usize>) -> (f64, bool) {
+    fn update_general(&mut self, crossings: usize, tolerance_m: f64) -> (f64, bool) {
         let m = self.set_count;
         for a in 0..m {
             let mut rhs = self.slot_forces[a];
@@ -873,23 +1071,18 @@ impl NodalContact {
             &mut self.right_side[..m],
             &mut self.scratch[..m],
         );
-        let mut delta = std::mem::take(&mut self.right_side);
-        let mut finished = false;
-        if let Some(c) = crossing {
-            let mut direction = std::mem::take(&mut self.scratch);
-            self.crossing_column(c, &mut direction[..m]);
-            ldl_substitute_in_place(&self.matrix[..m * m], m, &mut direction[..m]);
-            if let Some(departure) = self.exact_departure(c, &delta[..m], &direction[..m]) {
-                for (d, w) in delta[..m].iter_mut().zip(&direction[..m]) {
-                    *d += departure * w;
-                }
-                finished = true;
-            }
-            self.scratch = direction;
-        }
-        let largest = self.apply_update(&delta[..m]);
-        self.right_side = delta;
-        (largest, finished)
+        let mut delta = [0.0; NODE_CAPACITY];
+        delta[..m].copy_from_slice(&self.right_side[..m]);
+        let finished = crossings > 0
+            && self.finish_step(
+                |x: &mut [f64; NODE_CAPACITY]| {
+                    ldl_substitute_in_place(&self.matrix[..m * m], m, &mut x[..m]);
+                },
+                &mut delta,
+                crossings,
+                tolerance_m,
+            );
+        (self.apply_update(&delta[..m]), finished)
     }
 
     /// Adds each segment's `Σ c w_j w_l` to a fixed-lane matrix (upper triangle: `matrix[b][a]`,
