@@ -1609,6 +1609,23 @@ mod tests {
         assert!(all_widths.iter().all(|&steps| steps > 0), "{all_widths:?}");
     }
 
+    /// Asserts that both pickups (nut, bridge) of `other` lie sample by sample within
+    /// `relative` times their range in `ranged` of `ranged`'s.
+    fn assert_pickups_within(ranged: &[[f64; 2]], other: &[[f64; 2]], relative: f64) {
+        for pickup in 0..2 {
+            let range = ranged.iter().map(|f| f[pickup].abs()).fold(0.0, f64::max);
+            let worst = ranged
+                .iter()
+                .zip(other)
+                .map(|(a, b)| (a[pickup] - b[pickup]).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                worst <= relative * range,
+                "pickup {pickup}: {worst:e} of {range:e}"
+            );
+        }
+    }
+
     /// The condensed contact's update in fixed lanes (up to 8 and 16 nodes, every step here)
     /// and on the general path play the same string, to round-off (the two factorisations round
     /// differently): pickups within 1e-10 of their range over 0.2 s of a hard pluck on the
@@ -1641,18 +1658,7 @@ mod tests {
         };
         let (lanes, lane_stats) = run(false);
         let (general, general_stats) = run(true);
-        for pickup in 0..2 {
-            let range = lanes.iter().map(|f| f[pickup].abs()).fold(0.0, f64::max);
-            let worst = lanes
-                .iter()
-                .zip(&general)
-                .map(|(a, b)| (a[pickup] - b[pickup]).abs())
-                .fold(0.0, f64::max);
-            assert!(
-                worst <= 1e-10 * range,
-                "pickup {pickup}: {worst:e} of {range:e}"
-            );
-        }
+        assert_pickups_within(&lanes, &general, 1e-10);
         assert_eq!(lane_stats.iterations, general_stats.iterations);
         assert!(lane_stats.iterations > lane_stats.steps, "{lane_stats:?}");
     }
@@ -1702,21 +1708,7 @@ mod tests {
         let (_, iterated_stats) = run(true, 1e-12);
         assert_eq!(converged_stats.cap_hits, 0, "{converged_stats:?}");
         assert_eq!(finished_stats.cap_hits, 0, "{finished_stats:?}");
-        for pickup in 0..2 {
-            let range = converged
-                .iter()
-                .map(|f| f[pickup].abs())
-                .fold(0.0, f64::max);
-            let worst = finished
-                .iter()
-                .zip(&converged)
-                .map(|(a, b)| (a[pickup] - b[pickup]).abs())
-                .fold(0.0, f64::max);
-            assert!(
-                worst <= 1e-10 * range,
-                "pickup {pickup}: {worst:e} of {range:e}"
-            );
-        }
+        assert_pickups_within(&converged, &finished, 1e-10);
         eprintln!(
             "updates per step: finished {:.3}, iterated {:.3}, converged {:.3}",
             finished_stats.mean_iterations(),

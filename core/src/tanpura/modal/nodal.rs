@@ -24,7 +24,12 @@
 //! in contact: it is exactly the point-level update of section 4 (`J = I + G C`, multiplied by
 //! `H` on the nodes), so the iterates are the same up to round-off. The iteration stops when
 //! `max|δ| ≤ tolerance`, or exactly when an update leaves every tracked point in the linear case
-//! (in contact or out, before and after the step) it had at the last evaluation. The energy
+//! (in contact or out, before and after the step) it had at the last evaluation. Where the
+//! evaluation finds one to eight points crossing the contact's edge and every other in a linear
+//! case, the update finishes the step: one point by its own quadratic (section 4), several by
+//! Newton on their steps alone through `W = Lᵀ A⁻¹ L` on the update's factors
+//! ([`NodalContact::solve_crossings`]); it stands if every point that was in a linear case kept
+//! it. The energy
 //! balance (M3) holds as for the point-level solve: the forces are the same law at the same
 //! steps, and the modes take `Vᵀ f = Ψᵀ ΔF`.
 //!
@@ -880,7 +885,7 @@ impl NodalContact {
     }
 
     /// The finish of a step whose `k ≥ 2` crossing points are `crossing_points[..k]`, in
-    /// `K ≥ k` lanes (`docs/modal-tanpura.md`, section 11): with every other point in a linear
+    /// `K ≥ k` lanes (`docs/modal-tanpura.md`, section 12, "Several crossing points"): with every other point in a linear
     /// case, `A (Δy − Δy⁰) = ρ_N + Σ_d l_d ρ_d(s_d)`, so `Δy = Δy⁰ + δ + Σ_d ρ_d w_d` with
     /// `w_d = A⁻¹ l_d`, and the k crossing points' steps solve
     ///
