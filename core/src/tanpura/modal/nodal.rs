@@ -301,13 +301,19 @@ pub(super) fn write_node_row(node: usize, intervals: usize, modes: &ModeSet, row
     }
 }
 
+/// The first of four `places` that are consecutive, or `None` (a stencil that names a
+/// support's node twice): a span whose places are consecutive adds its sums as whole slices.
+#[inline(always)]
+fn consecutive_start(places: [usize; 4]) -> Option<usize> {
+    let first = places[0];
+    (places == [first, first + 1, first + 2, first + 3]).then_some(first)
+}
+
 /// Adds `sums` to `values` at the four `places`: as one slice when they are consecutive, else
-/// one by one in order (a stencil that names a support's node twice); either way each entry
-/// receives its sums in the same order.
+/// one by one in order; either way each entry receives its sums in the same order.
 #[inline(always)]
 fn add_at_places(values: &mut [f64], places: [usize; 4], sums: [f64; 4]) {
-    let first = places[0];
-    if places == [first, first + 1, first + 2, first + 3] {
+    if let Some(first) = consecutive_start(places) {
         for (value, sum) in values[first..first + 4].iter_mut().zip(sums) {
             *value += sum;
         }
@@ -315,6 +321,16 @@ fn add_at_places(values: &mut [f64], places: [usize; 4], sums: [f64; 4]) {
         for (place, sum) in places.into_iter().zip(sums) {
             values[place] += sum;
         }
+    }
+}
+
+/// Calls `add(a, b, value)` with a segment's `Σ c w_j w_l` (`sums`) at its `places`, a ≥ b, one
+/// pair of [`PAIRS`] after another: entry (a, b) of the symmetric matrix.
+#[inline(always)]
+fn add_pairs(places: [usize; 4], sums: &[[f64; 4]; 4], mut add: impl FnMut(usize, usize, f64)) {
+    for &(j, k) in &PAIRS {
+        let (a, b) = (places[j], places[k]);
+        add(a.max(b), a.min(b), sums[j][k]);
     }
 }
 
@@ -1103,18 +1119,15 @@ impl NodalContact {
             .iter()
             .zip(&self.segment_stiffness)
         {
-            let first = segment.places[0];
-            if segment.places == [first, first + 1, first + 2, first + 3] && first + 4 <= N {
-                for (row, row_sums) in matrix[first..first + 4].iter_mut().zip(sums) {
-                    for (value, sum) in row[first..first + 4].iter_mut().zip(row_sums) {
-                        *value += sum;
+            match consecutive_start(segment.places) {
+                Some(first) if first + 4 <= N => {
+                    for (row, row_sums) in matrix[first..first + 4].iter_mut().zip(sums) {
+                        for (value, sum) in row[first..first + 4].iter_mut().zip(row_sums) {
+                            *value += sum;
+                        }
                     }
                 }
-            } else {
-                for &(j, k) in &PAIRS {
-                    let (a, b) = (segment.places[j], segment.places[k]);
-                    matrix[a.min(b)][a.max(b)] += sums[j][k];
-                }
+                _ => add_pairs(segment.places, sums, |a, b, value| matrix[b][a] += value),
             }
         }
     }
@@ -1128,10 +1141,7 @@ impl NodalContact {
             .iter()
             .zip(&self.segment_stiffness)
         {
-            for &(j, k) in &PAIRS {
-                let (a, b) = (segment.places[j], segment.places[k]);
-                add(a.max(b), a.min(b), sums[j][k]);
-            }
+            add_pairs(segment.places, sums, &mut add);
         }
     }
 
@@ -1415,5 +1425,67 @@ mod tests {
             }
         }
         assert_eq!(sliced.map(f64::to_bits), one_by_one.map(f64::to_bits));
+    }
+
+    /// The pass after Newton that forms every point's gap by groups of [`LANES`] over bands of
+    /// nodes: over two plucks on the fine tier's points, after every step each point's gap is
+    /// its gap before less its stencil's four products with the nodes' steps, left to right,
+    /// bit for bit (the band's other nodes add exact zeros); every point left untracked lies
+    /// farther than the tracking band from contact (the lane maxima did flag the ones that came
+    /// near, and they joined); and points did come near and join, so the flag was exercised.
+    #[test]
+    fn the_gap_pass_by_groups_forms_each_points_stencil_step() {
+        use super::super::{GridModes, ModalString, ModalStringConfig, TRACKING_BAND_M};
+        use crate::tanpura::excitation::Pluck;
+        let mut string = ModalString::<f64>::new(ModalStringConfig {
+            bridge_point_spacing_m: 0.36e-3,
+            thread_point_spacing_m: 0.2e-3,
+            grid_modes: Some(GridModes {
+                intervals: 200,
+                time_step_s: 1.0 / (4.0 * 44_100.0),
+                condensed: true,
+            }),
+            ..ModalStringConfig::REFERENCE
+        });
+        assert!(string.nodal_in_use);
+        let count = string.nodal.point_count;
+        assert!(count > 2 * LANES, "{count} points");
+        let (mut joined, mut checked) = (0, 0);
+        for amplitude_m in [2e-3, 4e-3] {
+            string.pluck(&Pluck {
+                amplitude_m,
+                ..Pluck::default()
+            });
+            for step in 0..4410 {
+                let before = string.nodal.gaps_m[..count].to_vec();
+                let untracked_before: Vec<bool> = (0..count)
+                    .map(|i| string.nodal.far_offsets_m[i] == 0.0)
+                    .collect();
+                string.step();
+                let nodal = &string.nodal;
+                for i in 0..count {
+                    let moved = (0..4).fold(0.0, |sum, j| {
+                        sum + nodal.weight_columns[j][i]
+                            * nodal.node_steps_m[nodal.stencil_nodes[i][j]]
+                    });
+                    let expected = before[i] - moved;
+                    assert_eq!(
+                        nodal.gaps_m[i].to_bits(),
+                        expected.to_bits(),
+                        "step {step}, point {i}: {} against {expected}",
+                        nodal.gaps_m[i]
+                    );
+                    let untracked = nodal.far_offsets_m[i] == 0.0;
+                    assert!(
+                        !untracked || nodal.gaps_m[i] <= -TRACKING_BAND_M,
+                        "step {step}, point {i} untracked at gap {}",
+                        nodal.gaps_m[i]
+                    );
+                    joined += usize::from(untracked_before[i] && !untracked);
+                    checked += 1;
+                }
+            }
+        }
+        assert!(joined > 0 && checked > 0, "{joined} joins");
     }
 }

@@ -566,6 +566,86 @@ mod tests {
         assert!(y[n..].iter().all(|&v| v == 0.0));
     }
 
+    /// The row-wise left-looking LDLᵀ that [`ldl_factor_fixed`]'s doc names, entry by entry
+    /// (`w_k = L_jk d_k`; `d_j = a_jj − Σ_k L_jk w_k` and `L_ij = (a_ij − Σ_k L_ik w_k) · (1/d_j)`,
+    /// each product subtracted in turn, k ascending), and its substitutions (forward by rows,
+    /// k ascending; back by rows, later entries first), on `n` unknowns of an upper triangle.
+    fn row_wise_solve<const N: usize>(upper: &[[f64; N]; N], n: usize, x: &mut [f64; N]) {
+        let (mut lower, mut diagonal) = ([[0.0; N]; N], [0.0; N]);
+        for j in 0..n {
+            let weighted: [f64; N] = std::array::from_fn(|k| lower[j][k] * diagonal[k]);
+            let mut d = upper[j][j];
+            for k in 0..j {
+                d -= lower[j][k] * weighted[k];
+            }
+            diagonal[j] = d;
+            let inverse = 1.0 / d;
+            for i in j + 1..n {
+                let mut value = upper[j][i];
+                for k in 0..j {
+                    value -= lower[i][k] * weighted[k];
+                }
+                lower[i][j] = value * inverse;
+            }
+        }
+        for i in 0..n {
+            for k in 0..i {
+                x[i] -= lower[i][k] * x[k];
+            }
+        }
+        for i in 0..n {
+            x[i] /= diagonal[i];
+        }
+        for k in (0..n).rev() {
+            for i in (k + 1..n).rev() {
+                x[k] -= lower[i][k] * x[i];
+            }
+        }
+    }
+
+    /// The fixed-lane factorisation by columns over whole rows, and its substitutions, give the
+    /// row-wise loops' solution bit for bit, as their docs say: on a full matrix of 8 lanes and
+    /// on 5 unknowns padded with the identity (the padding solves x = 0), for matrices whose
+    /// entries round in every product.
+    #[test]
+    fn the_fixed_lane_ldl_is_the_row_wise_one_bit_for_bit() {
+        const LANES: usize = 8;
+        for n in [LANES, 5] {
+            let mut matrix = [[0.0; LANES]; LANES];
+            for (b, row) in matrix.iter_mut().enumerate() {
+                for (a, value) in row.iter_mut().enumerate() {
+                    *value = if a < n && b < n {
+                        let base = 1.0 / (1.0 + a as f64 + b as f64).sqrt();
+                        if a == b {
+                            3.1 + base + 0.7 * a as f64
+                        } else {
+                            0.9 * base
+                        }
+                    } else {
+                        (a == b) as u8 as f64
+                    };
+                }
+            }
+            let rhs: [f64; LANES] = std::array::from_fn(|i| {
+                if i < n {
+                    (1.3 * i as f64 - 2.1).sin()
+                } else {
+                    0.0
+                }
+            });
+            let mut expected = rhs;
+            row_wise_solve(&matrix, n, &mut expected);
+            let mut solved = rhs;
+            ldl_solve_fixed(&mut matrix, &mut solved);
+            assert_eq!(
+                solved.map(f64::to_bits),
+                expected.map(f64::to_bits),
+                "n = {n}"
+            );
+            assert!(solved[n..].iter().all(|&v| v == 0.0));
+        }
+    }
+
     #[test]
     fn ldl_solves_a_known_system() {
         // [[4,2,0],[2,5,1],[0,1,3]] x = [2, 7, 7] has x = [0, 1, 2]; lower triangle only.
