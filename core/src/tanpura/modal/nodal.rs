@@ -189,6 +189,9 @@ pub struct NodalContact {
     set_nodes: Vec<usize>,
     node_slots: Vec<usize>,
     inverse: Vec<f64>,
+    /// H by columns, as its solves leave them (`inverse_columns[b · NODE_CAPACITY + a]` is the
+    /// `H_ab` of column b's solve; zeros past |S|): the update's right side reads them.
+    inverse_columns: Vec<f64>,
     /// The tracked points in segments, and each segment's `Σ c w_j w_l` over [`PAIRS`] at the
     /// last evaluation.
     segments: Vec<Span>,
@@ -373,6 +376,7 @@ impl NodalContact {
             set_nodes: vec![0; NODE_CAPACITY],
             node_slots: vec![UNSET; NODE_CAPACITY],
             inverse: zeros(NODE_CAPACITY * NODE_CAPACITY),
+            inverse_columns: zeros(NODE_CAPACITY * NODE_CAPACITY),
             segments: vec![Span::default(); capacity],
             segment_count: 0,
             segment_stiffness: vec![[[0.0; 4]; 4]; capacity],
@@ -670,6 +674,9 @@ impl NodalContact {
             for a in 0..m {
                 self.inverse[a * NODE_CAPACITY + column] = x[a];
             }
+            let stored = &mut self.inverse_columns[column * NODE_CAPACITY..][..NODE_CAPACITY];
+            stored[..m].copy_from_slice(&x[..m]);
+            stored[m..].fill(0.0);
         }
     }
 
@@ -1037,7 +1044,7 @@ impl NodalContact {
         let m = self.set_count;
         let mut matrix = [[0.0; N]; N];
         let mut delta = [0.0; N];
-        // Δy − Δy_free on S, zero in the padding (which then subtracts zero products).
+        // Δy − Δy_free on S.
         let mut moved = [0.0; N];
         for ((value, step), free) in moved
             .iter_mut()
@@ -1052,11 +1059,18 @@ impl NodalContact {
                 continue;
             }
             row[..m].copy_from_slice(&self.inverse[a * NODE_CAPACITY..a * NODE_CAPACITY + m]);
-            let mut value = self.slot_forces[a];
-            for (&h, &change) in row.iter().zip(&moved) {
-                value -= h * change;
+        }
+        // The right side f − H (Δy − Δy_free) by H's columns: each entry less H_ab (Δy −
+        // Δy_free)_b for b in order, the products a row's dot would take in its order, but in N
+        // lanes at once: one chain of |S| vector steps instead of |S| chains of |S| dependent
+        // scalar ones, which the update waited on (stop 48 in `docs/performance.md`). The
+        // padding stays zero.
+        delta[..m].copy_from_slice(&self.slot_forces[..m]);
+        for (b, &change) in moved[..m].iter().enumerate() {
+            let column = &self.inverse_columns[b * NODE_CAPACITY..][..N];
+            for (value, &h) in delta.iter_mut().zip(column) {
+                *value -= h * change;
             }
-            delta[a] = value;
         }
         self.add_stiffnesses_fixed(&mut matrix);
         ldl_factor_fixed(&mut matrix);
