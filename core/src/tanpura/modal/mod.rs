@@ -1626,6 +1626,27 @@ mod tests {
         }
     }
 
+    /// The reference's string on its own grid's modes (N = 200, the trapezoidal rule at
+    /// 4 × 44.1 kHz), contact points every `bridge_m` on the bridge and `thread_m` on the
+    /// thread, the contact condensed on the grid's nodes or not (f64 modes in the tests that
+    /// compare its solves).
+    pub(super) fn grid_mode_config(
+        bridge_m: f64,
+        thread_m: f64,
+        condensed: bool,
+    ) -> ModalStringConfig {
+        ModalStringConfig {
+            bridge_point_spacing_m: bridge_m,
+            thread_point_spacing_m: thread_m,
+            grid_modes: Some(GridModes {
+                intervals: 200,
+                time_step_s: 1.0 / (4.0 * 44_100.0),
+                condensed,
+            }),
+            ..ModalStringConfig::REFERENCE
+        }
+    }
+
     /// The condensed contact's update in fixed lanes (up to 8 and 16 nodes, every step here)
     /// and on the general path play the same string, to round-off (the two factorisations round
     /// differently): pickups within 1e-10 of their range over 0.2 s of a hard pluck on the
@@ -1633,16 +1654,7 @@ mod tests {
     #[test]
     fn condensed_lanes_solve_as_the_general_path() {
         let run = |general_path_only: bool| {
-            let mut string = ModalString::<f64>::new(ModalStringConfig {
-                bridge_point_spacing_m: 0.18e-3,
-                thread_point_spacing_m: 0.15e-3,
-                grid_modes: Some(GridModes {
-                    intervals: 200,
-                    time_step_s: 1.0 / (4.0 * 44_100.0),
-                    condensed: true,
-                }),
-                ..ModalStringConfig::REFERENCE
-            });
+            let mut string = ModalString::<f64>::new(grid_mode_config(0.18e-3, 0.15e-3, true));
             assert!(string.nodal_in_use);
             if general_path_only {
                 string.nodal.take_general_path_only();
@@ -1673,18 +1685,11 @@ mod tests {
     fn several_crossings_finish_where_newtons_iteration_converges() {
         let run = |iterate: bool, tolerance_m: f64| {
             let mut string = ModalString::<f64>::new(ModalStringConfig {
-                bridge_point_spacing_m: 0.36e-3,
-                thread_point_spacing_m: 0.2e-3,
-                grid_modes: Some(GridModes {
-                    intervals: 200,
-                    time_step_s: 1.0 / (4.0 * 44_100.0),
-                    condensed: true,
-                }),
                 newton: NewtonSettings {
                     tolerance_m,
                     max_iterations: 30,
                 },
-                ..ModalStringConfig::REFERENCE
+                ..grid_mode_config(0.36e-3, 0.2e-3, true)
             });
             assert!(string.nodal_in_use);
             if iterate {
@@ -1730,16 +1735,7 @@ mod tests {
     fn the_static_problems_on_the_nodes_are_the_point_level_ones() {
         for (tension_n, bridge_m, thread_m) in [(52.0, 0.36e-3, 0.2e-3), (80.0, 0.18e-3, 0.15e-3)] {
             let build = |condensed: bool| {
-                let mut config = ModalStringConfig {
-                    bridge_point_spacing_m: bridge_m,
-                    thread_point_spacing_m: thread_m,
-                    grid_modes: Some(GridModes {
-                        intervals: 200,
-                        time_step_s: 1.0 / (4.0 * 44_100.0),
-                        condensed,
-                    }),
-                    ..ModalStringConfig::REFERENCE
-                };
+                let mut config = grid_mode_config(bridge_m, thread_m, condensed);
                 config.string.tension_n = tension_n;
                 let string = ModalString::<f64>::new(config);
                 assert_eq!(string.nodal_in_use, condensed);

@@ -1449,18 +1449,10 @@ mod tests {
     /// near, and they joined); and points did come near and join, so the flag was exercised.
     #[test]
     fn the_gap_pass_by_groups_forms_each_points_stencil_step() {
-        use super::super::{GridModes, ModalString, ModalStringConfig, TRACKING_BAND_M};
+        use super::super::tests::grid_mode_config;
+        use super::super::{ModalString, TRACKING_BAND_M};
         use crate::tanpura::excitation::Pluck;
-        let mut string = ModalString::<f64>::new(ModalStringConfig {
-            bridge_point_spacing_m: 0.36e-3,
-            thread_point_spacing_m: 0.2e-3,
-            grid_modes: Some(GridModes {
-                intervals: 200,
-                time_step_s: 1.0 / (4.0 * 44_100.0),
-                condensed: true,
-            }),
-            ..ModalStringConfig::REFERENCE
-        });
+        let mut string = ModalString::<f64>::new(grid_mode_config(0.36e-3, 0.2e-3, true));
         assert!(string.nodal_in_use);
         let count = string.nodal.point_count;
         assert!(count > 2 * LANES, "{count} points");
