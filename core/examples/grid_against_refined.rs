@@ -14,8 +14,9 @@
 //! five minutes on two cores); `-- --grid-modes` the same with every mode of the reference's FD
 //! grid instead of the continuous string's (§10); `-- --grid-spacings` the grid modes with the
 //! contact condensed on the nodes (§11) and contact points from the reference's spacing to the
-//! tier's. `cargo xtask bench` measures the same without the residual modes, and caches the
-//! refined renders.
+//! tier's; `-- --bands KEY VELOCITY POSITION_M` which 1/6-octave bands part the fine tier, the
+//! studio tier, the reference and the refined string at one pluck. `cargo xtask bench` measures
+//! the same without the residual modes, and caches the refined renders.
 //!
 //! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
 //! tier tuned by linearising about its own rest state (no calibration as played), so that the
@@ -24,7 +25,9 @@
 //! are quoted in `docs/modal-tanpura.md`, section 9 ("Stop 35"; `--rate-grid`: "Stop 40";
 //! `--grid-modes`: section 10; `--grid-spacings`: section 11).
 
-use javari_core::analysis::listening::{compare, ListeningDifference};
+use javari_core::analysis::listening::{
+    band_edges_hz, band_levels_db, compare, ListeningDifference, BAND_FLOOR_DB,
+};
 use javari_core::analysis::playing_range::{full_grid, GridPoint, CREST_KEYS};
 use javari_core::analysis::refined::{
     grid_pluck, grid_render_linearised, grid_render_refined, modal_variant_pluck,
@@ -454,8 +457,89 @@ fn live_variants(args: &[String]) {
     }
 }
 
+/// Per band of [`band_edges_hz`]: the RMS over the frames of `render`'s level less
+/// `reference`'s, counted as the band-level measure counts it (the render floored at
+/// [`BAND_FLOOR_DB`] below the reference frame's loudest band, only bands above that floor), and
+/// in how many frames the band counted.
+fn band_differences(render: &[f64], reference: &[f64]) -> Vec<(f64, usize)> {
+    let (mine, theirs) = (
+        band_levels_db(render, SAMPLE_RATE_HZ),
+        band_levels_db(reference, SAMPLE_RATE_HZ),
+    );
+    let bands = theirs.first().map_or(0, Vec::len);
+    let mut sums = vec![(0.0, 0usize); bands];
+    for (frame, reference_frame) in mine.iter().zip(&theirs) {
+        let floor = reference_frame.iter().copied().fold(f64::MIN, f64::max) - BAND_FLOOR_DB;
+        for ((sum, level), reference_level) in sums.iter_mut().zip(frame).zip(reference_frame) {
+            if *reference_level > floor {
+                sum.0 += (level.max(floor) - reference_level).powi(2);
+                sum.1 += 1;
+            }
+        }
+    }
+    sums.into_iter()
+        .map(|(sum, count)| ((sum / count.max(1) as f64).sqrt(), count))
+        .collect()
+}
+
+/// `--bands KEY VELOCITY POSITION_M`: one pluck of the grid on the reference, the fine and the
+/// studio tier and the refined string, all tuned by linearisation: each pair's band-level
+/// distance (the bench's measure), then band by band the reference's mean level and each
+/// difference's RMS over the frames (see [`band_differences`]): which bands part the tiers, and
+/// whether the reference is nearer the refined string there than the fine tier is.
+fn bands(args: &[String]) {
+    let (_, point) = pluck_after(args, "--bands");
+    let render = |quality| grid_render_linearised(quality, &point, SAMPLE_RATE_HZ, 0);
+    let (reference, fine, studio) = (
+        render(Quality::Reference),
+        render(Quality::Fine),
+        render(Quality::Studio),
+    );
+    let refined = grid_render_refined(&point, SAMPLE_RATE_HZ);
+    let nominal = point.nominal_hz();
+    let distance = |a: &[f64], b: &[f64]| compare(a, b, SAMPLE_RATE_HZ, nominal).band_level_db;
+    println!(
+        "{}, tuned by linearisation: band-level distances (dB RMS)",
+        point.label()
+    );
+    for (label, render, against) in [
+        ("fine against the reference", &fine, &reference),
+        ("studio against the reference", &studio, &reference),
+        ("the reference against refined", &reference, &refined),
+        ("fine against refined", &fine, &refined),
+        ("studio against refined", &studio, &refined),
+    ] {
+        println!("  {label:<32} {:5.2}", distance(render, against));
+    }
+    let levels = band_levels_db(&reference, SAMPLE_RATE_HZ);
+    let pairs = [
+        band_differences(&fine, &reference),
+        band_differences(&studio, &reference),
+        band_differences(&reference, &refined),
+        band_differences(&fine, &refined),
+    ];
+    println!("band centre Hz, reference mean dB, frames counted; RMS dB: fine−ref, studio−ref, ref−refined, fine−refined");
+    for (band, edges) in band_edges_hz(SAMPLE_RATE_HZ).windows(2).enumerate() {
+        let mean = levels.iter().map(|frame| frame[band]).sum::<f64>() / levels.len().max(1) as f64;
+        println!(
+            "{:8.0} {:7.1} {:3} {:6.2} {:6.2} {:6.2} {:6.2}",
+            (edges[0] * edges[1]).sqrt(),
+            mean,
+            pairs[0][band].1,
+            pairs[0][band].0,
+            pairs[1][band].0,
+            pairs[2][band].0,
+            pairs[3][band].0
+        );
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if args.iter().any(|arg| arg == "--bands") {
+        bands(&args);
+        return;
+    }
     if args.iter().any(|arg| arg == "--yardstick-check") {
         yardstick_check();
         return;
