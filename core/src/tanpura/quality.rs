@@ -15,15 +15,17 @@
 //! - Fine runs the modal scheme on the reference's own grid (`docs/modal-tanpura.md` §10–11): every
 //!   mode of the seed's FD grid (N = 200, the 199 sampled sines with the frequencies and decays
 //!   of its trapezoidal rule at 4× the output rate), advanced exactly at the output rate, with the
-//!   contact points every 0.36 mm of the bridge and 0.2 mm of the thread seen through the FD's
-//!   cubic interpolation and solved on the 11 grid nodes they reach (`modal/nodal.rs`), the rest
-//!   state, the finger's press and the tuning too (`modal/nodal_statics.rs`). It is the
-//!   reference's string in space and its partials in time, at a modal tier's cost; its jawari is
-//!   set on the reference's (`as_played::jawari_set_on`). Points 0.36 / 0.2 mm apart lie about as
-//!   near the reference as its own barrier grids' 0.18 / 0.15 mm do (worst pluck of the playing
-//!   range, linearised tuning: 0.68 against 0.54 cents, 7.74 against 7.61 dB, 12.65 against
-//!   12.91 %; `grid_against_refined -- --grid-spacings`); at 0.5 mm on the bridge the centroid
-//!   parts (22.8 %).
+//!   contact points the reference's own barrier points (every 0.18 mm of the bridge and 0.15 mm of
+//!   the thread, on the FD grids' lattices) seen through the FD's cubic interpolation and solved
+//!   on the 11 grid nodes they reach (`modal/nodal.rs`), the rest state, the finger's press and
+//!   the tuning too (`modal/nodal_statics.rs`). It is the reference's string in space and its
+//!   partials in time, at a modal tier's cost; its jawari is set on the reference's
+//!   (`as_played::jawari_set_on`). The points must be the reference's, not only as fine: at key
+//!   63's softest pluck the seed's grid feeds the 4th partial through the crest's grazing contact
+//!   with its points and not with points half a spacing away, and the fine string follows it on
+//!   the same points (`docs/modal-tanpura.md` §10, stop 50; worst pluck of the playing range,
+//!   linearised tuning: 5.68 dB against 7.74 dB with points every 0.36 / 0.2 mm from the fine
+//!   string's own start, median 1.28 against 1.97 dB, for 18–26 % of the tier's speed).
 //! - Studio and Reference run the seed's finite-difference scheme (`fd/`). Reference is the
 //!   seed's own discretisation (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm,
 //!   Δx_c = 0.15 mm) with a tolerance at round-off; Studio runs at 3 × 44.1 kHz and keeps the
@@ -135,8 +137,8 @@ impl Quality {
             }),
             Quality::Fine => Tier::Modal(ModalTier {
                 highest_mode_hz: 20_000.0,
-                bridge_point_spacing_m: 0.36e-3,
-                thread_point_spacing_m: 0.2e-3,
+                bridge_point_spacing_m: 0.18e-3,
+                thread_point_spacing_m: 0.15e-3,
                 newton: TIER_NEWTON,
                 grid_modes: true,
             }),

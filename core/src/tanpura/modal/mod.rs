@@ -219,6 +219,21 @@ impl ModalStringConfig {
         (speaking.min(first_touch) - 2e-3).max(self.bridge.start_m)
     }
 
+    /// The bridge's first point: [`Self::bridge_start_m`], or on grid modes the first point of
+    /// the reference's lattice (`bridge.start_m` and every spacing after it, as the FD string's
+    /// barrier grid places them) at or past it. On the seed's grid a string whose bridge points
+    /// lie half a spacing (0.09 mm) from the reference's plays the crest's grazing contact
+    /// otherwise (`docs/modal-tanpura.md` §10, stop 50).
+    fn bridge_first_point_m(&self) -> f64 {
+        let start = self.bridge_start_m();
+        if self.grid_modes.is_none() {
+            return start;
+        }
+        let (origin, spacing) = (self.bridge.start_m, self.bridge_point_spacing_m);
+        // The tolerance keeps a start that lies on the lattice where it is despite round-off.
+        origin + ((start - origin) / spacing - 1e-9).ceil().max(0.0) * spacing
+    }
+
     /// Where the bridge's points end: the bridge's end, or the thread without the bridge beyond it.
     fn bridge_end_m(&self) -> f64 {
         match (self.bridge.beyond_thread, self.thread) {
@@ -248,7 +263,8 @@ impl ModalStringConfig {
             .map(|lattice| lattice.spacing)
             .fold(f64::INFINITY, f64::min);
         let finest_spacing_m = finest * self.thread_point_spacing_m;
-        let thread = 2 * (half_width / finest_spacing_m).floor() as usize + 1;
+        // The symmetric lattice's 2⌊w/s⌋ + 1 points, or the grid's ⌊2w/s⌋ + 1 (one more at most).
+        let thread = 2 * (half_width / finest_spacing_m).floor() as usize + 2;
         bridge + thread
     }
 }
@@ -573,7 +589,7 @@ impl<T: Real> ModalString<T> {
         let config = self.config;
         self.points.place_bridge(
             &config.bridge,
-            config.bridge_start_m(),
+            config.bridge_first_point_m(),
             config.bridge_end_m(),
             config.bridge_point_spacing_m,
             config.time_step_s,
@@ -601,15 +617,26 @@ impl<T: Real> ModalString<T> {
         let config = self.config;
         self.thread_spacing_m = thread_spacing_m;
         self.thread_offset_m = thread_offset_m;
-        self.points.place_thread(
-            &config.bridge,
-            config.thread.as_ref(),
-            thread_spacing_m,
-            thread_offset_m,
-            config.time_step_s,
-            config.string.left_support_m,
-            config.string.length_m,
-        );
+        if config.grid_modes.is_some() {
+            self.points.place_thread_as_the_grid(
+                &config.bridge,
+                config.thread.as_ref(),
+                thread_spacing_m,
+                config.time_step_s,
+                config.string.left_support_m,
+                config.string.length_m,
+            );
+        } else {
+            self.points.place_thread(
+                &config.bridge,
+                config.thread.as_ref(),
+                thread_spacing_m,
+                thread_offset_m,
+                config.time_step_s,
+                config.string.left_support_m,
+                config.string.length_m,
+            );
+        }
         self.couple_points_from(first);
     }
 

@@ -192,6 +192,40 @@ impl ContactPoints {
         self.set_free_gaps(self.bridge_count, left_support_m, length_m);
     }
 
+    /// Places the thread's points where the FD string's barrier grid has them (`fd/mod.rs`):
+    /// from the first edge of its cap (`position − half width`), `thread_spacing_m` apart over
+    /// the cap's width, after the bridge's points of the last [`ContactPoints::place_bridge`],
+    /// which stay. The grid modes' rule (`docs/modal-tanpura.md` §10, stop 50): with the
+    /// reference's spacing the two strings then touch the thread at the same points.
+    /// Allocation-free.
+    pub fn place_thread_as_the_grid(
+        &mut self,
+        bridge: &BridgeSettings,
+        thread: Option<&ThreadSettings>,
+        thread_spacing_m: f64,
+        time_step_s: f64,
+        left_support_m: f64,
+        length_m: f64,
+    ) {
+        self.count = self.bridge_count;
+        if let Some(thread) = thread.filter(|thread| thread.stiffness_n_m2 > 0.0) {
+            let half_width = thread.half_width_m();
+            let first_m = thread.position_m - half_width;
+            for index in 0..grid_points(0.0, 2.0 * half_width, thread_spacing_m) {
+                let x = first_m + index as f64 * thread_spacing_m;
+                self.push(
+                    x,
+                    thread.height_over(bridge, x),
+                    thread_spacing_m,
+                    thread.stiffness_n_m2,
+                    thread.damping_s_m,
+                    time_step_s,
+                );
+            }
+        }
+        self.set_free_gaps(self.bridge_count, left_support_m, length_m);
+    }
+
     /// g_i = h_i − y_s(x_i) for the points `first..`.
     fn set_free_gaps(&mut self, first: usize, left_support_m: f64, length_m: f64) {
         for i in first..self.count {
