@@ -182,7 +182,7 @@ fn the_fine_string_on_the_reference_points_plays_the_fd_string() {
         (sum / count as f64).sqrt()
     };
     let fd_rms = rms(&mut fd_nut.iter().copied());
-    let mut fine = settings.clone();
+    let mut fine = settings;
     fine.quality = Quality::Fine;
     let tier_config = fine
         .modal_config_at(Quality::Fine, SAMPLE_RATE)
