@@ -26,7 +26,7 @@
 //! `--grid-modes`: section 10; `--grid-spacings`: section 11).
 
 use javari_core::analysis::listening::{
-    band_edges_hz, band_levels_db, compare, ListeningDifference, BAND_FLOOR_DB,
+    band_edges_hz, band_levels_db, compare, counted_band_differences_db, ListeningDifference,
 };
 use javari_core::analysis::playing_range::{full_grid, GridPoint, CREST_KEYS};
 use javari_core::analysis::refined::{
@@ -458,9 +458,8 @@ fn live_variants(args: &[String]) {
 }
 
 /// Per band of [`band_edges_hz`]: the RMS over the frames of `render`'s level less
-/// `reference`'s, counted as the band-level measure counts it (the render floored at
-/// [`BAND_FLOOR_DB`] below the reference frame's loudest band, only bands above that floor), and
-/// in how many frames the band counted.
+/// `reference`'s, counted as the band-level measure counts it
+/// ([`counted_band_differences_db`]), and in how many frames the band counted.
 fn band_differences(render: &[f64], reference: &[f64]) -> Vec<(f64, usize)> {
     let (mine, theirs) = (
         band_levels_db(render, SAMPLE_RATE_HZ),
@@ -469,12 +468,9 @@ fn band_differences(render: &[f64], reference: &[f64]) -> Vec<(f64, usize)> {
     let bands = theirs.first().map_or(0, Vec::len);
     let mut sums = vec![(0.0, 0usize); bands];
     for (frame, reference_frame) in mine.iter().zip(&theirs) {
-        let floor = reference_frame.iter().copied().fold(f64::MIN, f64::max) - BAND_FLOOR_DB;
-        for ((sum, level), reference_level) in sums.iter_mut().zip(frame).zip(reference_frame) {
-            if *reference_level > floor {
-                sum.0 += (level.max(floor) - reference_level).powi(2);
-                sum.1 += 1;
-            }
+        for (band, difference) in counted_band_differences_db(frame, reference_frame) {
+            sums[band].0 += difference.powi(2);
+            sums[band].1 += 1;
         }
     }
     sums.into_iter()

@@ -120,21 +120,32 @@ pub fn band_levels_db(signal: &[f64], sample_rate_hz: f64) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// The bands of one frame that the band-level measure counts (the reference's level above
+/// [`BAND_FLOOR_DB`] below its loudest band), each with its index and the render's level, floored
+/// there, less the reference's, dB.
+pub fn counted_band_differences_db<'a>(
+    levels: &'a [f64],
+    reference: &'a [f64],
+) -> impl Iterator<Item = (usize, f64)> + 'a {
+    let floor = reference.iter().copied().fold(f64::MIN, f64::max) - BAND_FLOOR_DB;
+    levels
+        .iter()
+        .zip(reference)
+        .enumerate()
+        .filter(move |(_, (_, r))| **r > floor)
+        .map(move |(band, (x, r))| (band, x.max(floor) - r))
+}
+
 /// RMS difference (dB) of two renders' band levels, averaged over frames; see the module doc.
 pub fn band_level_distance_db(levels: &[Vec<f64>], reference: &[Vec<f64>]) -> f64 {
     let frames = levels.len().min(reference.len());
     let mut total = 0.0;
     let mut counted = 0usize;
     for (mine, theirs) in levels.iter().zip(reference).take(frames) {
-        let loudest = theirs.iter().copied().fold(f64::MIN, f64::max);
-        let floor = loudest - BAND_FLOOR_DB;
-        let (mut sum, mut count) = (0.0, 0usize);
-        for (x, r) in mine.iter().zip(theirs) {
-            if *r > floor {
-                sum += (x.max(floor) - r).powi(2);
-                count += 1;
-            }
-        }
+        let (sum, count) = counted_band_differences_db(mine, theirs)
+            .fold((0.0, 0usize), |(sum, count), (_, difference)| {
+                (sum + difference.powi(2), count + 1)
+            });
         if count > 0 {
             total += (sum / count as f64).sqrt();
             counted += 1;
