@@ -86,12 +86,29 @@ impl ThreadSettings {
         (2.0 * self.curvature_radius_m * self.height_m).sqrt()
     }
 
+    /// The thread's points at `spacing_m` as the FD string's barrier grid lays them: the first
+    /// at the cap's first edge (`position − half width`), and how many cover the cap's width.
+    /// The grid modes lay theirs the same way, so that both strings touch the thread at the same
+    /// points (`docs/modal-tanpura.md` §10, stop 50).
+    pub fn barrier_lattice(&self, spacing_m: f64) -> (f64, usize) {
+        let half_width = self.half_width_m();
+        (
+            self.position_m - half_width,
+            grid_points(0.0, 2.0 * half_width, spacing_m),
+        )
+    }
+
     /// Height of the thread's top surface at `x` (it sits on the bridge), m.
     pub fn height_over(&self, bridge: &BridgeSettings, x_m: f64) -> f64 {
         let offset = x_m - self.position_m;
         bridge.height_m(self.position_m) + self.height_m
             - offset * offset / (2.0 * self.curvature_radius_m)
     }
+}
+
+/// Points of a grid covering `[start, end]` with the given spacing (at least one).
+pub fn grid_points(start_m: f64, end_m: f64, spacing_m: f64) -> usize {
+    ((end_m - start_m) / spacing_m).floor().max(0.0) as usize + 1
 }
 
 /// The plucking finger's grid and contact law.

@@ -46,7 +46,7 @@
 use crate::banded::{BandedLdlt, SymmetricBanded};
 use crate::newton::{solve_bounded, NewtonSettings, NewtonStats, NewtonSystem};
 use crate::tanpura::excitation::{finger_height_m, first_mode_shape, Pluck};
-use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
+use crate::tanpura::geometry::{grid_points, BridgeSettings, FingerSettings, ThreadSettings};
 use crate::tanpura::string::StringParameters;
 use barrier_grid::{lagrange_stencil, BarrierGrid};
 use condensed::ContactCondensation;
@@ -450,15 +450,12 @@ impl FdString {
 
         match config.thread {
             Some(thread) => {
-                let half_width = thread.half_width_m();
-                let points = grid_points(0.0, 2.0 * half_width, thread.spacing_m);
-                self.solver.thread.place(
-                    thread.position_m - half_width,
-                    thread.spacing_m,
-                    points,
-                    dx,
-                    |x| thread.height_over(&bridge, x),
-                );
+                let (first_m, points) = thread.barrier_lattice(thread.spacing_m);
+                self.solver
+                    .thread
+                    .place(first_m, thread.spacing_m, points, dx, |x| {
+                        thread.height_over(&bridge, x)
+                    });
                 self.solver
                     .thread
                     .set_law(thread.stiffness_n_m2, thread.damping_s_m, dt, density);
@@ -1069,11 +1066,6 @@ fn contact_node_range(config: &FdStringConfig, spacing_m: f64) -> Option<(usize,
     let first = lagrange_stencil(lowest / spacing_m, n).0.max(1);
     let last = (lagrange_stencil(highest / spacing_m, n).0 + 3).min(n - 1);
     (first <= last).then_some((first, last))
-}
-
-/// Points of a grid covering `[start, end]` with the given spacing (at least one).
-fn grid_points(start_m: f64, end_m: f64, spacing_m: f64) -> usize {
-    ((end_m - start_m) / spacing_m).floor().max(0.0) as usize + 1
 }
 
 /// Cubic Lagrange interpolation of a full-node vector at a position in grid units.

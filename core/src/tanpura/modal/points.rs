@@ -15,7 +15,7 @@ use super::lanes::{padded_lanes, Kernels};
 use super::modes::{ModeSet, MODE_CAPACITY};
 use crate::dense::{leading_eigenpairs, symmetric_eigen_jacobi, LEADING_BLOCK_CAPACITY};
 use crate::tanpura::contact::HuntCrossley;
-use crate::tanpura::geometry::{BridgeSettings, ThreadSettings};
+use crate::tanpura::geometry::{grid_points, BridgeSettings, ThreadSettings};
 
 /// The bridge and thread points of one modal string; allocation-free after `with_capacity`.
 #[derive(Debug, Clone)]
@@ -55,11 +55,6 @@ pub struct ContactPoints {
     eigen_vectors: Vec<f64>,
     /// Subspace iteration's block and its image ([`leading_eigenpairs`]).
     eigen_work: Vec<f64>,
-}
-
-/// Points of a grid covering `[start, end]` with the given spacing (at least one).
-pub fn grid_points(start_m: f64, end_m: f64, spacing_m: f64) -> usize {
-    ((end_m - start_m) / spacing_m).floor().max(0.0) as usize + 1
 }
 
 impl ContactPoints {
@@ -172,23 +167,13 @@ impl ContactPoints {
         left_support_m: f64,
         length_m: f64,
     ) {
-        self.count = self.bridge_count;
-        if let Some(thread) = thread.filter(|thread| thread.stiffness_n_m2 > 0.0) {
-            let side = (thread.half_width_m() / thread_spacing_m).floor() as usize;
-            for index in 0..2 * side + 1 {
-                let x = thread.position_m
-                    + thread_offset_m
-                    + (index as f64 - side as f64) * thread_spacing_m;
-                self.push(
-                    x,
-                    thread.height_over(bridge, x),
-                    thread_spacing_m,
-                    thread.stiffness_n_m2,
-                    thread.damping_s_m,
-                    time_step_s,
-                );
-            }
-        }
+        let side = thread.map_or(0, |thread| {
+            (thread.half_width_m() / thread_spacing_m).floor() as usize
+        });
+        let centre_m = thread.map_or(0.0, |thread| thread.position_m + thread_offset_m);
+        let positions = (0..2 * side + 1)
+            .map(|index| centre_m + (index as f64 - side as f64) * thread_spacing_m);
+        self.place_thread_points(bridge, thread, positions, thread_spacing_m, time_step_s);
         self.set_free_gaps(self.bridge_count, left_support_m, length_m);
     }
 
@@ -207,23 +192,37 @@ impl ContactPoints {
         left_support_m: f64,
         length_m: f64,
     ) {
-        self.count = self.bridge_count;
-        if let Some(thread) = thread.filter(|thread| thread.stiffness_n_m2 > 0.0) {
-            let half_width = thread.half_width_m();
-            let first_m = thread.position_m - half_width;
-            for index in 0..grid_points(0.0, 2.0 * half_width, thread_spacing_m) {
-                let x = first_m + index as f64 * thread_spacing_m;
-                self.push(
-                    x,
-                    thread.height_over(bridge, x),
-                    thread_spacing_m,
-                    thread.stiffness_n_m2,
-                    thread.damping_s_m,
-                    time_step_s,
-                );
-            }
-        }
+        let (first_m, count) =
+            thread.map_or((0.0, 0), |thread| thread.barrier_lattice(thread_spacing_m));
+        let positions = (0..count).map(|index| first_m + index as f64 * thread_spacing_m);
+        self.place_thread_points(bridge, thread, positions, thread_spacing_m, time_step_s);
         self.set_free_gaps(self.bridge_count, left_support_m, length_m);
+    }
+
+    /// The thread's points at `positions`, each standing for `spacing_m` of it, after the
+    /// bridge's, if the thread has a positive stiffness.
+    fn place_thread_points(
+        &mut self,
+        bridge: &BridgeSettings,
+        thread: Option<&ThreadSettings>,
+        positions: impl Iterator<Item = f64>,
+        spacing_m: f64,
+        time_step_s: f64,
+    ) {
+        self.count = self.bridge_count;
+        let Some(thread) = thread.filter(|thread| thread.stiffness_n_m2 > 0.0) else {
+            return;
+        };
+        for x in positions {
+            self.push(
+                x,
+                thread.height_over(bridge, x),
+                spacing_m,
+                thread.stiffness_n_m2,
+                thread.damping_s_m,
+                time_step_s,
+            );
+        }
     }
 
     /// g_i = h_i − y_s(x_i) for the points `first..`.
