@@ -205,6 +205,9 @@ impl Plugin for Javari {
             _ => Engine::new(&settings, rate, DEFAULT_VOICE_COUNT),
         };
         engine.adopt_tier_latency();
+        // Off the audio thread: every playable note's tension, so that a note-on configures its
+        // string instead of tuning it (`javari_core::engine::tuning_memory`).
+        engine.prepare_tunings();
         context.set_latency_samples(latency_in_samples(&engine));
         self.restart_requested = false;
         self.engine = Some(engine);

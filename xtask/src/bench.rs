@@ -129,9 +129,19 @@ impl Scene for Drone {
 }
 
 /// Eight strings plucked as in MIDI play: the engine with eight voices, a note every 0.1 s over
-/// the first 0.8 s (a spread chord from D3 up), all left ringing.
+/// the first 0.8 s (a spread chord from D3 up), all left ringing. The engine is prepared as the
+/// plugin prepares it when the host activates it (`Engine::prepare_tunings`, untimed), so a
+/// note-on configures its string at a remembered tension instead of tuning it.
 struct EightVoices {
     engine: Engine,
+}
+
+impl EightVoices {
+    fn new(settings: &EngineSettings) -> Self {
+        let mut engine = Engine::new(settings, SAMPLE_RATE, 8);
+        engine.prepare_tunings();
+        Self { engine }
+    }
 }
 
 const EIGHT_VOICE_NOTES: [u8; 8] = [50, 53, 57, 60, 62, 65, 69, 72];
@@ -493,9 +503,7 @@ pub fn run_all(seconds: f64, runs: u32) -> Vec<BenchResult> {
                                 voice: settings,
                                 ..EngineSettings::default()
                             };
-                            Box::new(EightVoices {
-                                engine: Engine::new(&engine_settings, SAMPLE_RATE, 8),
-                            })
+                            Box::new(EightVoices::new(&engine_settings))
                         }
                         _ => {
                             let mut tanpura = Tanpura::new(&settings, sa, SAMPLE_RATE);
@@ -740,11 +748,7 @@ pub fn run_economy(seconds: f64, runs: u32) -> Vec<EconomyRow> {
             ..EngineSettings::default()
         };
         rows.push(row(
-            &|| {
-                Box::new(EightVoices {
-                    engine: Engine::new(&engine_settings, SAMPLE_RATE, 8),
-                })
-            },
+            &|| Box::new(EightVoices::new(&engine_settings)),
             name,
             note,
         ));

@@ -48,6 +48,7 @@ pub mod pitch;
 pub mod preset;
 pub mod render;
 pub mod smoothing;
+pub mod tuning_memory;
 pub mod wav;
 
 use crate::bowed::{BowedEvent, BowedInstrument, BowedPlayerSettings, StringConstants};
@@ -57,6 +58,7 @@ use crate::tanpura::excitation::Pluck;
 use crate::tanpura::{reference_fundamental_hz, TanpuraVoice, VoiceSettings};
 use drone::{string_ratios, DroneSequencer, DroneSettings};
 use smoothing::Ramp;
+use tuning_memory::TuningMemory;
 
 /// The pickup force, in newtons, that maps to digital full scale (±1.0) at 0 dB output gain,
 /// for a string at the reference pitch ([`reference_fundamental_hz`]).
@@ -618,6 +620,8 @@ pub struct Engine {
     /// Strings plucked without a current calibration, for the host to measure off the audio
     /// thread ([`Engine::take_wanted_calibration`]).
     wanted: [Option<CalibrationRequest>; WANTED_CAPACITY],
+    /// The tensions strings were tuned to, by their settings (`tuning_memory.rs`).
+    tunings: TuningMemory,
 }
 
 /// Calibration requests an engine keeps until they are taken.
@@ -702,6 +706,7 @@ impl Engine {
             side_body: Body::new(&TANPURA_BODY, sample_rate_hz),
             as_played: AsPlayedTuning::default(),
             wanted: [None; WANTED_CAPACITY],
+            tunings: TuningMemory::new(),
         };
         engine.apply_bowed_settings();
         engine
@@ -1178,19 +1183,65 @@ impl Engine {
         }
     }
 
-    /// Moves the smoothed settings one control step and passes them to the ringing strings.
-    fn control_tick(&mut self) {
-        let target = self.target.voice;
-        let mut settings = target;
-        settings.bridge_stiffness_n_m2 = log_to_stiffness(self.bridge_stiffness_log.step());
-        settings.thread_position_m = self.thread_position.step();
-        settings.gamma_per_s = self.gamma.step();
-        settings.eta_s = self.eta.step();
-        settings.nut_pickup_weight = self.pickup_weight.step();
+    /// The target's voice settings with the smoothed controls at `controls`: the bridge's
+    /// stiffness (in its logarithmic domain), the thread's position, γ, η and the pickup mix.
+    fn voice_with_controls(&self, controls: [f64; 5]) -> VoiceSettings {
+        let [stiffness_log, thread_position_m, gamma_per_s, eta_s, nut_pickup_weight] = controls;
+        let mut settings = self.target.voice;
+        settings.bridge_stiffness_n_m2 = log_to_stiffness(stiffness_log);
+        settings.thread_position_m = thread_position_m;
+        settings.gamma_per_s = gamma_per_s;
+        settings.eta_s = eta_s;
+        settings.nut_pickup_weight = nut_pickup_weight;
         if self.target.tanpura_output == TanpuraOutput::Radiated {
             // The body hears the bridge.
             settings.nut_pickup_weight = 0.0;
         }
+        settings
+    }
+
+    /// Tunes a string for every note the current tuning can play and remembers the tensions
+    /// (`tuning_memory.rs`), with the settings the strings take once the smoothed controls have
+    /// reached their targets: a note-on on one of them then configures its string once instead
+    /// of tuning it. For the host to call off the audio thread when it activates the plugin;
+    /// allocates a scratch voice, and takes about 40 ms at the fine tier (80 notes).
+    pub fn prepare_tunings(&mut self) {
+        let controls = [
+            self.bridge_stiffness_log.target(),
+            self.thread_position.target(),
+            self.gamma.target(),
+            self.eta.target(),
+            self.pickup_weight.target(),
+        ];
+        let base = self.voice_with_controls(controls);
+        let mut voice = TanpuraVoice::new(&base, self.sample_rate_hz);
+        for note in 0..=127u8 {
+            let Some(hz) = self.target.tuning.playable_note_hz(note) else {
+                continue;
+            };
+            let settings = self.string_settings_from(&base, StringKey::Note(note), hz);
+            if self.tunings.tension_n(&settings).is_none() {
+                voice.set_settings(&settings);
+                self.tunings.remember(&settings, voice.tension_n());
+            }
+        }
+    }
+
+    /// The tuning memory (`tuning_memory.rs`).
+    pub fn tuning_memory(&self) -> &TuningMemory {
+        &self.tunings
+    }
+
+    /// Moves the smoothed settings one control step and passes them to the ringing strings.
+    fn control_tick(&mut self) {
+        let controls = [
+            self.bridge_stiffness_log.step(),
+            self.thread_position.step(),
+            self.gamma.step(),
+            self.eta.step(),
+            self.pickup_weight.step(),
+        ];
+        let mut settings = self.voice_with_controls(controls);
         settings.fundamental_hz = self.current_voice.fundamental_hz;
         let drone_strings = self.target.drone.strings;
         for slot in &mut self.slots {
@@ -1380,7 +1431,17 @@ impl Engine {
     /// The settings of the string that plays `key` at `fundamental_hz` now (before its
     /// as-played offset): the smoothed shared settings, the note, and a drone string's thread.
     fn string_settings(&self, key: StringKey, fundamental_hz: f64) -> VoiceSettings {
-        let mut settings = self.current_voice;
+        self.string_settings_from(&self.current_voice, key, fundamental_hz)
+    }
+
+    /// [`Engine::string_settings`] from the voice settings `base`.
+    fn string_settings_from(
+        &self,
+        base: &VoiceSettings,
+        key: StringKey,
+        fundamental_hz: f64,
+    ) -> VoiceSettings {
+        let mut settings = *base;
         settings.fundamental_hz = fundamental_hz;
         if let StringKey::Drone(index) = key {
             settings.thread_position_m += self.target.drone.strings[index].thread_offset_m;
@@ -1448,8 +1509,16 @@ impl Engine {
         slot.thread_set_m = thread_set_m;
         slot.pan = pan;
         slot.level_factor = slot.pitch_level * level;
-        // Also brings a re-plucked string to the current quality tier.
-        slot.voice.set_settings(&string_settings);
+        // Also brings a re-plucked string to the current quality tier; a string tuned before
+        // with these settings is configured at the tension it took then (`tuning_memory.rs`).
+        match self.tunings.tension_n(&string_settings) {
+            Some(tension) => slot.voice.set_settings_tuned(&string_settings, tension),
+            None => {
+                slot.voice.set_settings(&string_settings);
+                self.tunings
+                    .remember(&string_settings, slot.voice.tension_n());
+            }
+        }
         let padding = slot.padding_to(self.latency);
         if slot.delay.length != padding {
             slot.delay.set_length(padding);

@@ -630,3 +630,76 @@ fn a_drone_sa_set_in_the_settings_plays_without_a_held_note_and_stops_when_unset
         "a set Sa plans the drone's strings on Sa whatever the notes (Pa, Sa, low Sa)"
     );
 }
+
+/// A note-on whose string settings were tuned before configures its string at the tension
+/// remembered then, without tuning it again: one voice plays A3, is stolen by C4 and then by A3
+/// again, and the third note-on tunes nothing and sets the first one's tension bit for bit,
+/// which is the tension a fresh voice tunes A3 to (within round-off).
+#[test]
+fn a_note_on_with_settings_tuned_before_takes_the_remembered_tension() {
+    let settings = EngineSettings::default();
+    let mut engine = Engine::new(&settings, RATE, 1);
+    let tunings = |engine: &Engine| engine.slots[0].voice.tunings();
+    let made = tunings(&engine);
+    run(&mut engine, &[note_on(0, 57)], 64);
+    assert_eq!(tunings(&engine), made + 1, "A3 is tuned");
+    let a3_tension = engine.slots[0].voice.tension_n();
+    let a3_settings = *engine.slots[0].voice.settings();
+    assert_eq!(
+        engine.tuning_memory().tension_n(&a3_settings),
+        Some(a3_tension)
+    );
+    run(&mut engine, &[note_on(0, 60)], 64);
+    assert_eq!(tunings(&engine), made + 2, "C4 is tuned");
+    assert_ne!(engine.slots[0].voice.tension_n(), a3_tension);
+    run(&mut engine, &[note_on(0, 57)], 64);
+    assert_eq!(tunings(&engine), made + 2, "A3 comes from the memory");
+    assert_eq!(
+        engine.slots[0].voice.tension_n().to_bits(),
+        a3_tension.to_bits()
+    );
+    let fresh = TanpuraVoice::new(&a3_settings, RATE);
+    let relative = (fresh.tension_n() - a3_tension).abs() / a3_tension;
+    assert!(relative < 1e-9, "{relative:e}");
+}
+
+/// [`Engine::prepare_tunings`] remembers a tension for every playable note (MIDI 16–95 at
+/// A4 = 440 Hz), after which a phrase's note-ons tune no string, and the phrase sounds as it
+/// does from an engine that tunes each string on its note-on (to round-off).
+#[test]
+fn prepared_tunings_leave_note_ons_nothing_to_tune_and_sound_the_same() {
+    let settings = EngineSettings::default();
+    let mut prepared = Engine::new(&settings, RATE, 4);
+    let mut tuning = Engine::new(&settings, RATE, 4);
+    prepared.prepare_tunings();
+    let playable = (0..=127u8)
+        .filter(|&note| settings.tuning.playable_note_hz(note).is_some())
+        .count();
+    assert_eq!(playable, 80);
+    assert_eq!(prepared.tuning_memory().len(), playable);
+    let tunings =
+        |engine: &Engine| -> u64 { engine.slots.iter().map(|slot| slot.voice.tunings()).sum() };
+    let (prepared_made, tuning_made) = (tunings(&prepared), tunings(&tuning));
+    let phrase = [
+        note_on(0, 50),
+        note_on(1500, 57),
+        note_on(3000, 62),
+        note_on(4500, 69),
+    ];
+    let heard = run(&mut prepared, &phrase, 9000);
+    let expected = run(&mut tuning, &phrase, 9000);
+    assert_eq!(
+        tunings(&prepared),
+        prepared_made,
+        "nothing tuned on a note-on"
+    );
+    assert_eq!(tunings(&tuning), tuning_made + 4);
+    let loudest = peak(&expected);
+    assert!(loudest > 1e-3, "{loudest}");
+    let largest = heard
+        .iter()
+        .zip(&expected)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+    assert!(largest <= 1e-5 * loudest, "{largest:e} of {loudest:e}");
+}

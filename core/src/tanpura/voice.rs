@@ -378,6 +378,8 @@ pub struct TanpuraVoice {
     strings: Vec<TierString>,
     /// The settings each tier's string was last configured for.
     configured: Vec<Option<VoiceSettings>>,
+    /// How many times a string of this voice was tuned (the tension scaled to the pitch).
+    tunings: u64,
     /// One decimator per oversampling factor, built up front.
     decimators: Vec<Decimator>,
     sleeping: bool,
@@ -413,12 +415,13 @@ impl TanpuraVoice {
             output_sample_rate_hz,
             strings,
             configured: vec![None; Quality::ALL.len()],
+            tunings: 0,
             decimators,
             sleeping: true,
             tail_remaining: 0,
             samples_since_sleep_check: 0,
         };
-        voice.configure_string();
+        voice.configure_string(None);
         voice.string_mut().reset();
         voice
     }
@@ -465,7 +468,11 @@ impl TanpuraVoice {
     /// (`linearised_fundamental_hz` of either discretisation) is the requested pitch. The
     /// contact geometry makes the speaking length differ from "thread to nut" by up to 1 %,
     /// which would be 18 cents; two passes of `T ← T (f / f_lin)²` bring it under 0.1 cent.
-    fn configure_string(&mut self) {
+    ///
+    /// With `known_tension_n` (the tension these settings were tuned to before, by
+    /// [`TanpuraVoice::tension_n`]), a change that needs the tuning configures the string once
+    /// at that tension instead.
+    fn configure_string(&mut self, known_tension_n: Option<f64>) {
         let settings = self.settings;
         let index = settings.quality.index();
         if self.configured[index] == Some(settings) {
@@ -497,6 +504,12 @@ impl TanpuraVoice {
                 return;
             }
         }
+        if let Some(tension) = known_tension_n.filter(|t| t.is_finite() && *t > 0.0) {
+            self.apply_config(Some(tension));
+            self.configured[index] = Some(settings);
+            return;
+        }
+        self.tunings += 1;
         self.apply_config(None);
         // A string with no fundamental keeps the tension reached so far.
         let _ = tune_tension(
@@ -512,13 +525,41 @@ impl TanpuraVoice {
     /// Applies new settings (clamped) without allocating. The string keeps ringing, unless
     /// the quality tier changes: the new tier's string then starts at rest.
     pub fn set_settings(&mut self, settings: &VoiceSettings) {
+        self.apply_settings(settings, None);
+    }
+
+    /// [`TanpuraVoice::set_settings`] where the tension that tunes the string for `settings` is
+    /// known: `tension_n` is [`TanpuraVoice::tension_n`] of a voice set to the same settings
+    /// (their losses and pickup mix aside, which the tuning does not see). A retune then
+    /// configures the string once at that tension, where [`TanpuraVoice::set_settings`] tunes it
+    /// (three configurations and two linearised fundamentals; at the fine tier about 0.35 of
+    /// a note-on's 0.45 ms, `docs/performance.md`). Allocation-free.
+    pub fn set_settings_tuned(&mut self, settings: &VoiceSettings, tension_n: f64) {
+        self.apply_settings(settings, Some(tension_n));
+    }
+
+    /// The tension of the current tier's string, N: after a retune, what tunes it to the
+    /// settings' pitch.
+    pub fn tension_n(&self) -> f64 {
+        self.strings[self.settings.quality.index()]
+            .parameters()
+            .tension_n
+    }
+
+    /// How many times this voice tuned a string (scaled its tension to the pitch) since it
+    /// was made: a retune by [`TanpuraVoice::set_settings_tuned`] does not count.
+    pub fn tunings(&self) -> u64 {
+        self.tunings
+    }
+
+    fn apply_settings(&mut self, settings: &VoiceSettings, known_tension_n: Option<f64>) {
         let settings = settings.clamped();
         if settings == self.settings {
             return;
         }
         let tier_changed = settings.quality != self.settings.quality;
         self.settings = settings;
-        self.configure_string();
+        self.configure_string(known_tension_n);
         if tier_changed {
             let oversample = self.oversample();
             self.decimators[oversample - 1].reset();

@@ -1,0 +1,167 @@
+//! The tensions that tune the engine's strings, remembered per string settings, so that a
+//! note-on on a string tuned before configures its voice once instead of tuning it.
+//!
+//! A note-on that takes a voice tuned to another pitch retunes it
+//! ([`crate::tanpura::TanpuraVoice::set_settings`]): the tension is scaled twice by
+//! `T ← T (f / f_lin)²`, each pass a configuration of the string (its modes, its rest state on
+//! bridge and thread) and an inverse iteration for its linearised fundamental, then configured
+//! a third time. At the fine tier that is about 0.35 ms of the note-on's 0.45 ms on a 2.6 GHz
+//! AVX-512 Xeon, a quarter of a 64-sample block's deadline, on top of the block's other strings
+//! (`docs/performance.md`, "Stop 51"). The tension it reaches is a function of the settings
+//! alone (the losses and the pickup mix aside, which the tuning does not see), so the engine
+//! remembers it: the next note-on with the same settings configures the string once at that
+//! tension ([`crate::tanpura::TanpuraVoice::set_settings_tuned`]).
+//!
+//! The memory fills as strings are tuned on note-ons, and [`crate::engine::Engine::prepare_tunings`]
+//! fills it off the audio thread for every note the tuning can play, as a host does when it
+//! activates the plugin. Its entries are keyed by the whole settings, so a change of any
+//! setting the tuning sees (the thread, the bridge, the tier, the pitch) finds none and tunes
+//! the string as before; the oldest entry makes room for a new one. A fixed array searched in
+//! order: its [`TUNING_MEMORY_CAPACITY`] entries are compared in about a microsecond, against
+//! the 0.3 ms a hit saves, and nothing allocates after [`TuningMemory::new`].
+
+use crate::tanpura::VoiceSettings;
+
+/// Settings remembered at once: every playable note of one tuning (MIDI 16–95 at A4 = 440 Hz)
+/// with room for the drone's strings and calibrated variants.
+pub const TUNING_MEMORY_CAPACITY: usize = 128;
+
+/// Tuned tensions by string settings.
+#[derive(Debug, Clone)]
+pub struct TuningMemory {
+    entries: Vec<(VoiceSettings, f64)>,
+    /// Where the next entry goes once the memory is full (the oldest).
+    next: usize,
+}
+
+impl Default for TuningMemory {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl TuningMemory {
+    /// An empty memory with room for [`TUNING_MEMORY_CAPACITY`] entries. Allocates.
+    pub fn new() -> Self {
+        Self {
+            entries: Vec::with_capacity(TUNING_MEMORY_CAPACITY),
+            next: 0,
+        }
+    }
+
+    /// The settings as the tuning sees them: clamped, without the losses and the pickup mix.
+    fn key(settings: &VoiceSettings) -> VoiceSettings {
+        let clamped = settings.clamped();
+        let reference = VoiceSettings::default();
+        VoiceSettings {
+            gamma_per_s: reference.gamma_per_s,
+            eta_s: reference.eta_s,
+            nut_pickup_weight: reference.nut_pickup_weight,
+            ..clamped
+        }
+    }
+
+    /// The tension remembered for `settings`, N. Allocation-free.
+    pub fn tension_n(&self, settings: &VoiceSettings) -> Option<f64> {
+        let key = Self::key(settings);
+        self.entries
+            .iter()
+            .find(|(settings, _)| *settings == key)
+            .map(|&(_, tension)| tension)
+    }
+
+    /// Remembers that `tension_n` tunes the string for `settings` (a tension that is not a
+    /// positive number is not kept). Allocation-free.
+    pub fn remember(&mut self, settings: &VoiceSettings, tension_n: f64) {
+        if !(tension_n.is_finite() && tension_n > 0.0) {
+            return;
+        }
+        let key = Self::key(settings);
+        if let Some(entry) = self
+            .entries
+            .iter_mut()
+            .find(|(settings, _)| *settings == key)
+        {
+            entry.1 = tension_n;
+            return;
+        }
+        if self.entries.len() < TUNING_MEMORY_CAPACITY {
+            self.entries.push((key, tension_n));
+        } else {
+            self.entries[self.next] = (key, tension_n);
+            self.next = (self.next + 1) % TUNING_MEMORY_CAPACITY;
+        }
+    }
+
+    /// How many settings are remembered.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// Forgets every entry (a new sample rate tunes every string anew). Allocation-free.
+    pub fn clear(&mut self) {
+        self.entries.clear();
+        self.next = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The losses and the pickup mix do not enter the key; the pitch and the thread do; a full
+    /// memory forgets its oldest entry first; a tension that is not a positive number is not
+    /// remembered.
+    #[test]
+    fn remembers_by_the_settings_the_tuning_sees() {
+        let mut memory = TuningMemory::new();
+        let settings = VoiceSettings::default();
+        memory.remember(&settings, 30.0);
+        let damped = VoiceSettings {
+            gamma_per_s: 3.0,
+            eta_s: 1e-8,
+            nut_pickup_weight: 0.2,
+            ..settings
+        };
+        assert_eq!(memory.tension_n(&damped), Some(30.0));
+        let higher = VoiceSettings {
+            fundamental_hz: settings.fundamental_hz * 1.5,
+            ..settings
+        };
+        assert_eq!(memory.tension_n(&higher), None);
+        let moved = VoiceSettings {
+            thread_position_m: settings.thread_position_m + 1e-3,
+            ..settings
+        };
+        assert_eq!(memory.tension_n(&moved), None);
+        memory.remember(&settings, 31.0);
+        assert_eq!((memory.tension_n(&settings), memory.len()), (Some(31.0), 1));
+        memory.remember(&higher, f64::NAN);
+        memory.remember(&higher, 0.0);
+        assert_eq!(memory.tension_n(&higher), None);
+
+        for index in 0..TUNING_MEMORY_CAPACITY {
+            let pitched = VoiceSettings {
+                fundamental_hz: 100.0 + index as f64,
+                ..settings
+            };
+            memory.remember(&pitched, 1.0 + index as f64);
+        }
+        assert_eq!(memory.len(), TUNING_MEMORY_CAPACITY);
+        assert_eq!(memory.tension_n(&settings), None, "the oldest went first");
+        let newest = VoiceSettings {
+            fundamental_hz: 100.0 + (TUNING_MEMORY_CAPACITY - 1) as f64,
+            ..settings
+        };
+        assert_eq!(
+            memory.tension_n(&newest),
+            Some(TUNING_MEMORY_CAPACITY as f64)
+        );
+        memory.clear();
+        assert!(memory.is_empty());
+    }
+}
