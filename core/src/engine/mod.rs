@@ -1204,7 +1204,7 @@ impl Engine {
     /// (`tuning_memory.rs`), with the settings the strings take once the smoothed controls have
     /// reached their targets: a note-on on one of them then configures its string once instead
     /// of tuning it. For the host to call off the audio thread when it activates the plugin;
-    /// allocates a scratch voice, and takes about 40 ms at the fine tier (80 notes).
+    /// allocates a scratch voice, and took 32–33 ms at the fine tier (80 notes) on a 2.6 GHz Xeon.
     pub fn prepare_tunings(&mut self) {
         let controls = [
             self.bridge_stiffness_log.target(),
