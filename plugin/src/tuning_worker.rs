@@ -5,7 +5,10 @@
 //! later block. A string plays with its linearised tuning (or the last calibration of its note)
 //! until then: about a second after the first pluck of a new note at the live tier, several at
 //! the studio tier, whose calibration takes the reference's jawari and so measures the
-//! reference's calibration first (`as_played::jawari_set_on`).
+//! reference's calibration first (`as_played::jawari_set_on`). With each calibration the worker
+//! tunes the string it calibrates (`Calibration::calibrated_tension_n`) and hands the tension
+//! back with it, so that the string's next pluck configures it once at that tension instead of
+//! tuning it on the audio thread (`Engine::set_calibration_tuned`).
 //!
 //! Both directions are lock-free fixed-size queues (`crossbeam::queue::ArrayQueue`): the audio
 //! thread only pushes and pops, never waits, locks or allocates (a full queue drops the request;
@@ -28,7 +31,8 @@ const REMEMBERED: usize = 64;
 
 struct Shared {
     requests: ArrayQueue<(CalibrationRequest, f64)>,
-    results: ArrayQueue<Calibration>,
+    /// Each calibration with the tension that tunes its string, if one was found.
+    results: ArrayQueue<(Calibration, Option<f64>)>,
     stop: AtomicBool,
 }
 
@@ -56,8 +60,11 @@ impl TuningWorker {
     /// On the audio thread: hands the finished calibrations to `engine` and passes on the
     /// strings it wants measured. Lock-free, allocation-free.
     pub fn exchange(&self, engine: &mut Engine) {
-        while let Some(calibration) = self.shared.results.pop() {
-            engine.set_calibration(&calibration);
+        while let Some((calibration, tension_n)) = self.shared.results.pop() {
+            match tension_n {
+                Some(tension_n) => engine.set_calibration_tuned(&calibration, tension_n),
+                None => engine.set_calibration(&calibration),
+            }
         }
         let rate = engine.sample_rate_hz();
         while let Some(request) = engine.take_wanted_calibration() {
@@ -81,8 +88,9 @@ fn run(shared: &Shared) {
             continue;
         };
         let calibration = recall_or_measure(&mut remembered, &request, rate);
+        let result = (calibration, calibration.calibrated_tension_n());
         // The audio thread empties the queue every block; if it is full, wait for it.
-        while shared.results.push(calibration).is_err() {
+        while shared.results.push(result).is_err() {
             if shared.stop.load(Ordering::Relaxed) {
                 return;
             }
@@ -139,6 +147,14 @@ mod tests {
         assert!(calibration.offset_cents.is_finite());
         // A3 at the live tier settles without the jawari set.
         assert_eq!(calibration.thread_offset_m, 0.0);
+        // The tension came with it: the calibrated string's next pluck has nothing to tune.
+        let calibrated = calibration
+            .calibrated_settings()
+            .expect("a finite calibration");
+        assert_eq!(
+            engine.tuning_memory().tension_n(&calibrated),
+            calibration.calibrated_tension_n()
+        );
     }
 
     #[test]

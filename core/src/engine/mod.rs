@@ -862,6 +862,21 @@ impl Engine {
         self.as_played.insert(*calibration);
     }
 
+    /// [`Engine::set_calibration`] with the tension that tunes the calibrated string
+    /// ([`Calibration::calibrated_tension_n`], found off the audio thread where the calibration
+    /// was measured): the engine remembers it (`tuning_memory.rs`), so the string's next pluck
+    /// configures it once instead of tuning it on the audio thread. A calibration for another
+    /// sample rate, or one the engine does not take, remembers nothing. Allocation-free.
+    pub fn set_calibration_tuned(&mut self, calibration: &Calibration, tension_n: f64) {
+        self.set_calibration(calibration);
+        if calibration.sample_rate_hz != self.sample_rate_hz {
+            return;
+        }
+        if let Some(settings) = calibration.calibrated_settings() {
+            self.tunings.remember(&settings, tension_n);
+        }
+    }
+
     /// The calibrations the engine tunes with.
     pub fn as_played_tuning(&self) -> &AsPlayedTuning {
         &self.as_played
@@ -1478,9 +1493,7 @@ impl Engine {
             }
             let as_played = self.as_played.as_played(&string_settings);
             thread_set_m = as_played.thread_offset_m;
-            string_settings.fundamental_hz *= (as_played.offset_cents / 1200.0).exp2();
-            string_settings.thread_position_m += thread_set_m;
-            string_settings = string_settings.clamped();
+            string_settings = as_played.applied_to(&string_settings);
         }
         let level = match key {
             StringKey::Drone(string) => self.drone_levels[string],

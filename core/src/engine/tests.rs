@@ -663,6 +663,66 @@ fn a_note_on_with_settings_tuned_before_takes_the_remembered_tension() {
     assert!(relative < 1e-9, "{relative:e}");
 }
 
+/// A calibration handed over with the tension that tunes its string
+/// ([`Engine::set_calibration_tuned`], as the plugin's tuning worker hands it) leaves the
+/// string's next pluck nothing to tune: the calibrated A3 is configured at that tension bit for
+/// bit, with the settings the calibration gives, where an engine handed the calibration alone
+/// tunes the string on the note-on (to the same tension within round-off). A calibration for
+/// another sample rate remembers nothing.
+#[test]
+fn a_calibration_handed_over_with_its_tension_leaves_the_next_pluck_nothing_to_tune() {
+    let settings = EngineSettings::default();
+    assert!(settings.tuning.as_played);
+    let mut handed = Engine::new(&settings, RATE, 1);
+    let mut alone = Engine::new(&settings, RATE, 1);
+    let tunings = |engine: &Engine| engine.slots[0].voice.tunings();
+    let (handed_made, alone_made) = (tunings(&handed), tunings(&alone));
+    run(&mut handed, &[note_on(0, 57)], 64);
+    run(&mut alone, &[note_on(0, 57)], 64);
+    let request = handed
+        .take_wanted_calibration()
+        .expect("a calibration is wanted");
+    let calibration = Calibration {
+        request,
+        sample_rate_hz: RATE,
+        offset_cents: 3.0,
+        thread_offset_m: 0.1e-3,
+    };
+    let calibrated = calibration
+        .calibrated_settings()
+        .expect("a finite calibration");
+    let tension = calibration
+        .calibrated_tension_n()
+        .expect("a finite calibration");
+    let elsewhere = Calibration {
+        sample_rate_hz: 2.0 * RATE,
+        ..calibration
+    };
+    let remembered = handed.tuning_memory().len();
+    handed.set_calibration_tuned(&elsewhere, 0.5 * tension);
+    assert_eq!(handed.tuning_memory().len(), remembered, "another rate's");
+    handed.set_calibration_tuned(&calibration, tension);
+    alone.set_calibration(&calibration);
+    run(&mut handed, &[note_on(0, 57)], 64);
+    run(&mut alone, &[note_on(0, 57)], 64);
+    assert_eq!(
+        tunings(&handed),
+        handed_made + 1,
+        "only the first A3 is tuned"
+    );
+    assert_eq!(
+        tunings(&alone),
+        alone_made + 2,
+        "the calibrated A3 is tuned"
+    );
+    let voice = &handed.slots[0].voice;
+    assert_eq!(*voice.settings(), calibrated);
+    assert_eq!(voice.tension_n().to_bits(), tension.to_bits());
+    let tuned = alone.slots[0].voice.tension_n();
+    let relative = (tuned - tension).abs() / tension;
+    assert!(relative < 1e-9, "{relative:e}");
+}
+
 /// [`Engine::prepare_tunings`] remembers a tension for every playable note (MIDI 16–95 at
 /// A4 = 440 Hz), after which a phrase's note-ons tune no string, and the phrase sounds as it
 /// does from an engine that tunes each string on its note-on (to round-off).

@@ -236,6 +236,22 @@ pub struct AsPlayed {
     pub thread_offset_m: f64,
 }
 
+impl AsPlayed {
+    /// `settings` as a string with this calibration is plucked: the linearisation's target
+    /// raised by [`AsPlayed::offset_cents`], the thread moved by
+    /// [`AsPlayed::thread_offset_m`], clamped. The engine's note-on and the tuning worker's
+    /// [`Calibration::calibrated_settings`] both take it from here, so that a tension tuned off
+    /// the audio thread is found by the note-on that needs it.
+    pub fn applied_to(&self, settings: &VoiceSettings) -> VoiceSettings {
+        VoiceSettings {
+            fundamental_hz: settings.fundamental_hz * (self.offset_cents / 1200.0).exp2(),
+            thread_position_m: settings.thread_position_m + self.thread_offset_m,
+            ..*settings
+        }
+        .clamped()
+    }
+}
+
 /// The velocities a calibration checks a moved thread at: the soft end, midway and the firm end.
 fn check_velocities(velocities: [f64; 2]) -> [f64; 3] {
     [
@@ -553,6 +569,46 @@ impl Calibration {
         }
     }
 
+    /// The calibration as an engine holds it: its offset clamped to ±[`MAX_OFFSET_CENTS`] and
+    /// its thread move to ±[`THREAD_STEPS`] × [`THREAD_STEP_M`] (what a calibration can find;
+    /// a host handing back anything else is clamped), a non-finite thread move taken as none;
+    /// none with a non-finite offset.
+    pub fn clamped(mut self) -> Option<Self> {
+        if !self.offset_cents.is_finite() {
+            return None;
+        }
+        self.offset_cents = self.offset_cents.clamp(-MAX_OFFSET_CENTS, MAX_OFFSET_CENTS);
+        let largest_move_m = THREAD_STEPS as f64 * THREAD_STEP_M;
+        self.thread_offset_m = if self.thread_offset_m.is_finite() {
+            self.thread_offset_m.clamp(-largest_move_m, largest_move_m)
+        } else {
+            0.0
+        };
+        Some(self)
+    }
+
+    /// The settings an engine plucks the requested string with once it holds this
+    /// calibration ([`AsPlayed::applied_to`] of the clamped calibration); none when an engine
+    /// would not take it.
+    pub fn calibrated_settings(&self) -> Option<VoiceSettings> {
+        let calibration = self.clamped()?;
+        let as_played = AsPlayed {
+            offset_cents: calibration.offset_cents,
+            thread_offset_m: calibration.thread_offset_m,
+        };
+        Some(as_played.applied_to(&calibration.request.settings))
+    }
+
+    /// The tension that tunes [`Calibration::calibrated_settings`] at this calibration's sample
+    /// rate, as a voice's own tuning finds it: for the tuning worker to hand the engine with
+    /// the calibration ([`crate::engine::Engine::set_calibration_tuned`]), so that the string's
+    /// next pluck configures it once instead of tuning it on the audio thread. Builds a scratch
+    /// voice: allocates, off the audio thread only.
+    pub fn calibrated_tension_n(&self) -> Option<f64> {
+        let settings = self.calibrated_settings()?;
+        Some(TanpuraVoice::new(&settings, self.sample_rate_hz).tension_n())
+    }
+
     /// True when it was measured for this string and pluck (what the pickup mix does not touch
     /// aside; numbers equal to 1e-9, so that a setting that went through a glide's arithmetic
     /// still counts as the same).
@@ -633,25 +689,12 @@ impl AsPlayedTuning {
             .any(|entry| entry.is_for(request, sample_rate_hz))
     }
 
-    /// Adds a calibration (its offset clamped to ±[`MAX_OFFSET_CENTS`] and its thread move to
-    /// ±[`THREAD_STEPS`] × [`THREAD_STEP_M`], one with a non-finite offset ignored, a non-finite
-    /// thread move taken as none), replacing the one of the same note and tier, else a free
-    /// entry, else the oldest. Allocation-free.
-    pub fn insert(&mut self, mut calibration: Calibration) {
-        if !calibration.offset_cents.is_finite() {
+    /// Adds a calibration ([`Calibration::clamped`]; one with a non-finite offset is ignored),
+    /// replacing the one of the same note and tier, else a free entry, else the oldest.
+    /// Allocation-free.
+    pub fn insert(&mut self, calibration: Calibration) {
+        let Some(calibration) = calibration.clamped() else {
             return;
-        }
-        // What a calibration can find (a host handing back anything else is clamped).
-        calibration.offset_cents = calibration
-            .offset_cents
-            .clamp(-MAX_OFFSET_CENTS, MAX_OFFSET_CENTS);
-        let largest_move_m = THREAD_STEPS as f64 * THREAD_STEP_M;
-        calibration.thread_offset_m = if calibration.thread_offset_m.is_finite() {
-            calibration
-                .thread_offset_m
-                .clamp(-largest_move_m, largest_move_m)
-        } else {
-            0.0
         };
         let slot = self
             .entries
