@@ -334,9 +334,37 @@ pub struct ModalString<T: Real> {
     cumulative_losses_j: f64,
     external_work_j: f64,
     static_solve_failures: u64,
+    /// The last pluck's pressed modal state (`pressed_modal`, f64) and what it was pressed
+    /// with: the finger's centre, width and amplitude, and whether its static solve converged.
+    /// A pluck is a static solve from the rest state, not from the motion, so a string plucked
+    /// again the same way before its configuration or rest state changes (the drone's strings,
+    /// every cycle) takes it back instead of solving again, to the bit.
+    last_press: Option<LastPress>,
+    pressed_modal: Vec<f64>,
+    /// Presses solved (plucks that did not take the last one's pressed state back).
+    press_solves: u64,
     /// Static solves of the rest state since the string was built (the cost of a retune).
     rest_state_solves: u64,
     non_finite_resets: u64,
+}
+
+/// What a pluck pressed the string with, and whether the press's static solve converged
+/// ([`ModalString::pluck`] keeps the last one's pressed state).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct LastPress {
+    centre_m: f64,
+    width_m: f64,
+    amplitude_m: f64,
+    converged: bool,
+}
+
+impl LastPress {
+    /// The same finger, pressed as far: the same pressed state.
+    fn same_finger(&self, other: &Self) -> bool {
+        self.centre_m == other.centre_m
+            && self.width_m == other.width_m
+            && self.amplitude_m == other.amplitude_m
+    }
 }
 
 impl<T: Real> ModalString<T> {
@@ -382,6 +410,9 @@ impl<T: Real> ModalString<T> {
             cumulative_losses_j: 0.0,
             external_work_j: 0.0,
             static_solve_failures: 0,
+            last_press: None,
+            pressed_modal: vec![0.0; MODE_CAPACITY],
+            press_solves: 0,
             rest_state_solves: 0,
             non_finite_resets: 0,
         };
@@ -447,6 +478,7 @@ impl<T: Real> ModalString<T> {
     /// has with `keep_lattice` (a change that leaves the rest state alone), else on the one
     /// [`ModalString::place_thread_lattice`] takes. Leaves the rest state solved.
     fn apply_config(&mut self, keep_lattice: bool) {
+        self.last_press = None;
         let config = self.config;
         self.modes.configure(
             &config.string,
@@ -698,6 +730,7 @@ impl<T: Real> ModalString<T> {
     /// The static equilibrium on bridge and thread (section 5), warm-started from the last one:
     /// on the nodes with the condensed contact (`nodal_statics.rs`), else on the points.
     fn update_rest_state(&mut self) {
+        self.last_press = None;
         let count = self.points.len();
         let modes = self.modes.count();
         self.rest_state_solves += 1;
@@ -804,17 +837,25 @@ impl<T: Real> ModalString<T> {
                 self.contact.gaps_m[i] = self.modal_gap_m(i);
             }
         }
-        self.contact.classify(&self.points, TRACKING_BAND_M);
-        self.classify_nodal();
+        self.classify_points();
     }
 
-    /// The condensed contact's gaps from the point-level one's (exact on entry), and its
-    /// tracking from scratch.
-    fn classify_nodal(&mut self) {
+    /// The tracking of the points from scratch, from the gaps in `contact.gaps_m` (exact on
+    /// entry), for the solve in use: with the contact condensed on the nodes, the nodal
+    /// contact's (its gaps copied from those), else the point-level one's. The point-level
+    /// solve is not read while the contact is condensed, and a change of configuration that
+    /// takes it up again classifies it here first (`set_config` ends in `refresh_gaps`).
+    /// Classifying it on the nodes as well cleared and refilled its block of couplings, a
+    /// column of which strides the whole block: after half a second of steps, those lines were
+    /// out of cache, and a ringing fine string's pluck took up to 700 µs instead of 50 µs
+    /// (`docs/performance.md`, "Stop 52").
+    fn classify_points(&mut self) {
         if self.nodal_in_use {
             let count = self.points.len();
             self.nodal.gaps_m[..count].copy_from_slice(&self.contact.gaps_m[..count]);
             self.nodal.classify(TRACKING_BAND_M);
+        } else {
+            self.contact.classify(&self.points, TRACKING_BAND_M);
         }
     }
 
@@ -847,8 +888,7 @@ impl<T: Real> ModalString<T> {
         self.step.fill(T::default());
         let count = self.points.len();
         self.contact.gaps_m[..count].copy_from_slice(&self.points.rest_gaps_m[..count]);
-        self.contact.classify(&self.points, TRACKING_BAND_M);
-        self.classify_nodal();
+        self.classify_points();
         self.prepare_free_step();
         self.external_work_j -= energy_before;
         self.nut_force_change_n = 0.0;
@@ -1049,7 +1089,12 @@ impl<T: Real> ModalString<T> {
     /// How many contact points are awake (the others provably cannot touch before the next
     /// excitation, so their free steps are not computed).
     pub fn awake_point_count(&self) -> usize {
-        self.contact.awake_count()
+        if self.nodal_in_use {
+            // The condensed contact steps every point.
+            self.points.len()
+        } else {
+            self.contact.awake_count()
+        }
     }
 
     /// Forgets Newton's initial guess, so that a new excitation evolves exactly as it would on
@@ -1111,12 +1156,35 @@ impl<T: Real> ModalString<T> {
         let lowest = self.config.speaking_start_m() + half_width + 1e-3;
         let highest = length - half_width - 1e-3;
         let centre = pluck.position_m.clamp(lowest, highest.max(lowest));
-        let top = self.rest_displacement_at_m(centre) + amplitude;
         let modes = self.modes.count();
-        if self.nodal_in_use {
-            self.press_finger_on_nodes(centre, width, top);
-        } else {
-            self.press_finger_on_points(centre, width, top);
+        let press = LastPress {
+            centre_m: centre,
+            width_m: width,
+            amplitude_m: amplitude,
+            converged: true,
+        };
+        match self.last_press {
+            Some(last) if last.same_finger(&press) => {
+                self.row[..modes].copy_from_slice(&self.pressed_modal[..modes]);
+                if !last.converged {
+                    self.static_solve_failures += 1;
+                }
+            }
+            _ => {
+                let failures = self.static_solve_failures;
+                self.press_solves += 1;
+                let top = self.rest_displacement_at_m(centre) + amplitude;
+                if self.nodal_in_use {
+                    self.press_finger_on_nodes(centre, width, top);
+                } else {
+                    self.press_finger_on_points(centre, width, top);
+                }
+                self.pressed_modal[..modes].copy_from_slice(&self.row[..modes]);
+                self.last_press = Some(LastPress {
+                    converged: self.static_solve_failures == failures,
+                    ..press
+                });
+            }
         }
         for k in 0..MODE_CAPACITY {
             let pressed = if k < modes { self.row[k] } else { 0.0 };
@@ -1752,6 +1820,64 @@ mod tests {
             3 * finished_stats.iterations < 2 * iterated_stats.iterations,
             "{finished_stats:?} against {iterated_stats:?}"
         );
+    }
+
+    /// A string plucked again as before takes the last pluck's pressed state back without
+    /// solving the press, and plays on exactly as if it had solved it (the same pickups to the
+    /// bit over the next 2000 steps, on the nodes and on the points); a pluck pressed further,
+    /// and any pluck after a retune, solves the press again.
+    #[test]
+    fn a_pluck_repeated_takes_the_last_pressed_state_and_plays_on_to_the_bit() {
+        for condensed in [true, false] {
+            let config = grid_mode_config(0.36e-3, 0.2e-3, condensed);
+            let harder = Pluck {
+                amplitude_m: 3e-3,
+                ..Pluck::default()
+            };
+            let play = |remember: bool| {
+                let mut string = ModalString::<f32>::new(config);
+                assert_eq!(string.nodal_in_use, condensed);
+                let mut output = Vec::new();
+                let mut pluck_and_play = |string: &mut ModalString<f32>, pluck: &Pluck| {
+                    if !remember {
+                        string.last_press = None;
+                    }
+                    string.pluck(pluck);
+                    for _ in 0..2000 {
+                        string.step();
+                        output.push((string.nut_force_n(), string.bridge_force_n()));
+                    }
+                };
+                pluck_and_play(&mut string, &Pluck::default());
+                pluck_and_play(&mut string, &Pluck::default());
+                pluck_and_play(&mut string, &harder);
+                pluck_and_play(&mut string, &harder);
+                let retuned = ModalStringConfig {
+                    string: StringParameters {
+                        tension_n: 1.01 * config.string.tension_n,
+                        ..config.string
+                    },
+                    ..config
+                };
+                assert!(string.set_config(retuned));
+                pluck_and_play(&mut string, &harder);
+                (output, string.press_solves)
+            };
+            let (remembered, remembered_solves) = play(true);
+            let (solved, solved_solves) = play(false);
+            assert_eq!(solved_solves, 5);
+            assert_eq!(
+                remembered_solves, 3,
+                "the repeated plucks take the press back"
+            );
+            assert_eq!(remembered.len(), solved.len());
+            for (step, (a, b)) in remembered.iter().zip(&solved).enumerate() {
+                assert!(
+                    a.0.to_bits() == b.0.to_bits() && a.1.to_bits() == b.1.to_bits(),
+                    "condensed {condensed}, step {step}: {a:?} against {b:?}"
+                );
+            }
+        }
     }
 
     /// The static problems solved on the nodes (`nodal_statics.rs`) are the point-level ones
