@@ -846,9 +846,10 @@ impl<T: Real> ModalString<T> {
     /// solve is not read while the contact is condensed, and a change of configuration that
     /// takes it up again classifies it here first (`set_config` ends in `refresh_gaps`).
     /// Classifying it on the nodes as well cleared and refilled its block of couplings, a
-    /// column of which strides the whole block: after half a second of steps, those lines were
-    /// out of cache, and a ringing fine string's pluck took up to 700 µs instead of 50 µs
-    /// (`docs/performance.md`, "Stop 52").
+    /// column of which strides the whole block: after half a second of steps those lines are
+    /// out of cache, and that was a third of a ringing fine drone string's pluck, which took
+    /// 73–806 µs where the same pluck repeated at once took 37–52 µs (`docs/performance.md`,
+    /// "Stop 52").
     fn classify_points(&mut self) {
         if self.nodal_in_use {
             let count = self.points.len();
