@@ -1511,8 +1511,9 @@ impl Engine {
         };
         let slot = &mut self.slots[index];
         if slot.key != Some(key) || slot.fundamental_hz != fundamental_hz {
-            // A stolen string is stopped first: its old vibration belongs to another tuning.
-            slot.voice.reset();
+            // A stolen string is stopped first: its old vibration belongs to another tuning (the
+            // retune below solves its new rest state, so the old one is not solved again).
+            slot.voice.stop();
             slot.delay.clear();
             slot.key = Some(key);
             slot.fundamental_hz = fundamental_hz;
