@@ -723,6 +723,44 @@ fn a_calibration_handed_over_with_its_tension_leaves_the_next_pluck_nothing_to_t
     assert!(relative < 1e-9, "{relative:e}");
 }
 
+/// A note-on that takes a voice from another note stops the old vibration without solving the
+/// rest state it leaves ([`TanpuraVoice::stop`]): the retune to the new note is the only solve
+/// of a rest state, and the voice plays on as one reset first does, to the bit.
+#[test]
+fn a_stolen_voice_is_stopped_without_solving_the_rest_state_it_leaves() {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Fine;
+    let rest_state_solves = |engine: &Engine| match engine.slots[0].voice.string() {
+        crate::tanpura::tier_string::TierString::Modal(string) => string.rest_state_solves(),
+        crate::tanpura::tier_string::TierString::FiniteDifference(_) => {
+            panic!("the fine tier is modal")
+        }
+    };
+    let mut stopped = Engine::new(&settings, RATE, 1);
+    let mut reset = Engine::new(&settings, RATE, 1);
+    stopped.prepare_tunings();
+    reset.prepare_tunings();
+    run(&mut stopped, &[note_on(0, 57)], 2048);
+    run(&mut reset, &[note_on(0, 57)], 2048);
+    let before = rest_state_solves(&stopped);
+    let heard = run(&mut stopped, &[note_on(0, 60)], 4096);
+    assert_eq!(
+        rest_state_solves(&stopped),
+        before + 1,
+        "the retune's alone"
+    );
+    reset.slots[0].voice.reset();
+    let expected = run(&mut reset, &[note_on(0, 60)], 4096);
+    assert!(peak(&expected) > 1e-3);
+    assert!(
+        heard
+            .iter()
+            .zip(&expected)
+            .all(|(a, b)| a.to_bits() == b.to_bits()),
+        "a stopped voice plays as a reset one"
+    );
+}
+
 /// [`Engine::prepare_tunings`] remembers a tension for every playable note (MIDI 16–95 at
 /// A4 = 440 Hz), after which a phrase's note-ons tune no string, and the phrase sounds as it
 /// does from an engine that tunes each string on its note-on (to round-off).
