@@ -679,7 +679,6 @@ impl TanpuraVoice {
         !self.sleeping || self.tail_remaining > 0
     }
 
-    /// Silences the voice: string at rest, decimators cleared.
     /// Stops the string at its rest state, asleep, as [`TanpuraVoice::reset`] does, without
     /// solving that rest state again and keeping the string's statistics and ledgers: for a
     /// voice about to be retuned and plucked (a stolen voice), whose retune solves the new rest
@@ -690,15 +689,18 @@ impl TanpuraVoice {
     /// Allocation-free.
     pub fn stop(&mut self) {
         self.string_mut().settle_to_rest();
-        for decimator in &mut self.decimators {
-            decimator.reset();
-        }
-        self.sleeping = true;
-        self.tail_remaining = 0;
+        self.fall_silent();
     }
 
+    /// Silences the voice: string at rest (its rest state solved again, its statistics and
+    /// ledgers cleared), decimators cleared.
     pub fn reset(&mut self) {
         self.string_mut().reset();
+        self.fall_silent();
+    }
+
+    /// Clears the decimators and puts the voice to sleep with no tail left to play.
+    fn fall_silent(&mut self) {
         for decimator in &mut self.decimators {
             decimator.reset();
         }
