@@ -1198,6 +1198,18 @@ impl Engine {
         }
     }
 
+    /// `read` of each smoothed control, in the order [`Engine::voice_with_controls`] takes
+    /// them: the bridge's stiffness (logarithmic), the thread's position, γ, η, the pickup mix.
+    fn smoothed_controls(&mut self, mut read: impl FnMut(&mut Ramp) -> f64) -> [f64; 5] {
+        [
+            read(&mut self.bridge_stiffness_log),
+            read(&mut self.thread_position),
+            read(&mut self.gamma),
+            read(&mut self.eta),
+            read(&mut self.pickup_weight),
+        ]
+    }
+
     /// The target's voice settings with the smoothed controls at `controls`: the bridge's
     /// stiffness (in its logarithmic domain), the thread's position, γ, η and the pickup mix.
     fn voice_with_controls(&self, controls: [f64; 5]) -> VoiceSettings {
@@ -1221,13 +1233,7 @@ impl Engine {
     /// of tuning it. For the host to call off the audio thread when it activates the plugin;
     /// allocates a scratch voice, and took 32–33 ms at the fine tier (80 notes) on a 2.6 GHz Xeon.
     pub fn prepare_tunings(&mut self) {
-        let controls = [
-            self.bridge_stiffness_log.target(),
-            self.thread_position.target(),
-            self.gamma.target(),
-            self.eta.target(),
-            self.pickup_weight.target(),
-        ];
+        let controls = self.smoothed_controls(|control| control.target());
         let base = self.voice_with_controls(controls);
         let mut voice = TanpuraVoice::new(&base, self.sample_rate_hz);
         for note in 0..=127u8 {
@@ -1249,13 +1255,7 @@ impl Engine {
 
     /// Moves the smoothed settings one control step and passes them to the ringing strings.
     fn control_tick(&mut self) {
-        let controls = [
-            self.bridge_stiffness_log.step(),
-            self.thread_position.step(),
-            self.gamma.step(),
-            self.eta.step(),
-            self.pickup_weight.step(),
-        ];
+        let controls = self.smoothed_controls(Ramp::step);
         let mut settings = self.voice_with_controls(controls);
         settings.fundamental_hz = self.current_voice.fundamental_hz;
         let drone_strings = self.target.drone.strings;

@@ -5,7 +5,7 @@
 //! ([`crate::tanpura::TanpuraVoice::set_settings`]): the tension is scaled twice by
 //! `T ← T (f / f_lin)²`, each pass a configuration of the string (its modes, its rest state on
 //! bridge and thread) and an inverse iteration for its linearised fundamental, then configured
-//! a third time. At the fine tier that is about 0.35 ms of the note-on's 0.45 ms on a 2.6 GHz
+//! a third time. At the fine tier that took 345–357 µs of a note-on's 0.48 ms on a 2.6 GHz
 //! AVX-512 Xeon, a quarter of a 64-sample block's deadline, on top of the block's other strings
 //! (`docs/performance.md`, "Stop 51"). The tension it reaches is a function of the settings
 //! alone (the losses and the pickup mix aside, which the tuning does not see), so the engine
@@ -103,7 +103,7 @@ impl TuningMemory {
         self.entries.is_empty()
     }
 
-    /// Forgets every entry (a new sample rate tunes every string anew). Allocation-free.
+    /// Forgets every entry. Allocation-free.
     pub fn clear(&mut self) {
         self.entries.clear();
         self.next = 0;
