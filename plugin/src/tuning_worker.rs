@@ -10,14 +10,24 @@
 //! back with it, so that the string's next pluck configures it once at that tension instead of
 //! tuning it on the audio thread (`Engine::set_calibration_tuned`).
 //!
-//! Both directions are lock-free fixed-size queues (`crossbeam::queue::ArrayQueue`): the audio
-//! thread only pushes and pops, never waits, locks or allocates (a full queue drops the request;
-//! the engine asks again at the string's next pluck). The worker polls every
-//! `POLL_INTERVAL` when idle, and stops when the plugin is dropped.
+//! Between calibrations the worker tunes the strings of the engine's latest tuning plan: after
+//! a change of what the tuning sees (the bridge, the thread, the tier, the tuning), the engine
+//! hands out the new plan (`Engine::take_wanted_tuning_plan`), and the worker tunes every
+//! playable note's string with it and hands the tensions back one by one
+//! (`Engine::remember_tuning`), so that the notes played after the change configure their
+//! strings instead of tuning them on the audio thread. A newer plan replaces one in progress.
+//!
+//! Every direction is a lock-free fixed-size queue (`crossbeam::queue::ArrayQueue`): the audio
+//! thread only pushes and pops, never waits, locks or allocates (a full request queue drops the
+//! request, and the engine asks again at the string's next pluck; a newer plan displaces an
+//! older one still queued). The worker polls every `POLL_INTERVAL` when idle, and stops when the
+//! plugin is dropped.
 
 use crossbeam::queue::ArrayQueue;
+use javari_core::engine::tuning_memory::{PlannedTension, TuningPlan};
 use javari_core::engine::Engine;
 use javari_core::tanpura::as_played::{Calibration, CalibrationRequest};
+use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -33,6 +43,10 @@ struct Shared {
     requests: ArrayQueue<(CalibrationRequest, f64)>,
     /// Each calibration with the tension that tunes its string, if one was found.
     results: ArrayQueue<(Calibration, Option<f64>)>,
+    /// The latest tuning plan not yet taken up (one at most).
+    plans: ArrayQueue<TuningPlan>,
+    /// Tensions of the plan's strings.
+    tensions: ArrayQueue<PlannedTension>,
     stop: AtomicBool,
 }
 
@@ -47,6 +61,8 @@ impl TuningWorker {
         let shared = Arc::new(Shared {
             requests: ArrayQueue::new(QUEUE_CAPACITY),
             results: ArrayQueue::new(QUEUE_CAPACITY),
+            plans: ArrayQueue::new(1),
+            tensions: ArrayQueue::new(QUEUE_CAPACITY),
             stop: AtomicBool::new(false),
         });
         let worker = shared.clone();
@@ -57,8 +73,9 @@ impl TuningWorker {
         Self { shared }
     }
 
-    /// On the audio thread: hands the finished calibrations to `engine` and passes on the
-    /// strings it wants measured. Lock-free, allocation-free.
+    /// On the audio thread: hands the finished calibrations and tensions to `engine` and passes
+    /// on the strings it wants measured and the tuning plan it wants tuned. Lock-free,
+    /// allocation-free.
     pub fn exchange(&self, engine: &mut Engine) {
         while let Some((calibration, tension_n)) = self.shared.results.pop() {
             match tension_n {
@@ -66,10 +83,17 @@ impl TuningWorker {
                 None => engine.set_calibration(&calibration),
             }
         }
+        while let Some(tuned) = self.shared.tensions.pop() {
+            engine.remember_tuning(&tuned);
+        }
         let rate = engine.sample_rate_hz();
         while let Some(request) = engine.take_wanted_calibration() {
             // A full queue drops it; the string asks again at its next pluck.
             let _ = self.shared.requests.push((request, rate));
+        }
+        if let Some(plan) = engine.take_wanted_tuning_plan() {
+            // Displaces a plan the worker has not taken up yet.
+            let _ = self.shared.plans.force_push(plan);
         }
     }
 }
@@ -80,22 +104,68 @@ impl Drop for TuningWorker {
     }
 }
 
+/// A tuning plan being tuned: its scratch voice and the strings left, the next last.
+struct PlanInProgress {
+    plan: TuningPlan,
+    voice: TanpuraVoice,
+    strings_left: Vec<VoiceSettings>,
+}
+
+impl PlanInProgress {
+    fn new(plan: TuningPlan) -> Self {
+        let mut strings_left: Vec<_> = plan.strings().collect();
+        strings_left.reverse();
+        Self {
+            plan,
+            voice: plan.scratch_voice(),
+            strings_left,
+        }
+    }
+}
+
 fn run(shared: &Shared) {
     let mut remembered: Vec<Calibration> = Vec::with_capacity(REMEMBERED);
+    let mut in_progress: Option<PlanInProgress> = None;
     while !shared.stop.load(Ordering::Relaxed) {
-        let Some((request, rate)) = shared.requests.pop() else {
+        // Calibrations first: they are for strings being played.
+        if let Some((request, rate)) = shared.requests.pop() {
+            let calibration = recall_or_measure(&mut remembered, &request, rate);
+            let result = (calibration, calibration.calibrated_tension_n());
+            if !push_when_room(shared, &shared.results, result) {
+                return;
+            }
+            continue;
+        }
+        if let Some(plan) = shared.plans.pop() {
+            in_progress = Some(PlanInProgress::new(plan));
+        }
+        let Some(progress) = &mut in_progress else {
             std::thread::sleep(POLL_INTERVAL);
             continue;
         };
-        let calibration = recall_or_measure(&mut remembered, &request, rate);
-        let result = (calibration, calibration.calibrated_tension_n());
-        // The audio thread empties the queue every block; if it is full, wait for it.
-        while shared.results.push(result).is_err() {
-            if shared.stop.load(Ordering::Relaxed) {
-                return;
-            }
-            std::thread::sleep(POLL_INTERVAL);
+        let Some(string) = progress.strings_left.pop() else {
+            in_progress = None;
+            continue;
+        };
+        let tuned = progress.plan.tune(&mut progress.voice, &string);
+        if !push_when_room(shared, &shared.tensions, tuned) {
+            return;
         }
+    }
+}
+
+/// Pushes `item`, waiting while `queue` is full (the audio thread empties it every block).
+/// Returns false if the plugin stopped the worker meanwhile.
+fn push_when_room<T>(shared: &Shared, queue: &ArrayQueue<T>, mut item: T) -> bool {
+    loop {
+        match queue.push(item) {
+            Ok(()) => return true,
+            Err(back) => item = back,
+        }
+        if shared.stop.load(Ordering::Relaxed) {
+            return false;
+        }
+        std::thread::sleep(POLL_INTERVAL);
     }
 }
 
@@ -155,6 +225,42 @@ mod tests {
             engine.tuning_memory().tension_n(&calibrated),
             calibration.calibrated_tension_n()
         );
+    }
+
+    /// A change of the bridge's control is tuned by the worker: the engine's memory comes to
+    /// cover the new plan, and the notes played then tune no string on the audio thread.
+    #[test]
+    fn a_changed_bridge_comes_back_tuned() {
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = Quality::Draft;
+        settings.tuning.as_played = false;
+        let mut engine = Engine::new(&settings, 44_100.0, 4);
+        engine.prepare_tunings();
+        let worker = TuningWorker::start();
+        settings.voice.bridge_stiffness_n_m2 *= 10.0;
+        engine.set_settings(&settings);
+        let plan = engine.tuning_plan();
+        assert!(!engine.tuning_memory().covers(&plan));
+        let mut output = [0.0f32; 64];
+        let deadline = std::time::Instant::now() + Duration::from_secs(120);
+        while !engine.tuning_memory().covers(&plan) {
+            assert!(
+                std::time::Instant::now() < deadline,
+                "the plan was not tuned"
+            );
+            engine.process(&[], &mut output);
+            worker.exchange(&mut engine);
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        // The bridge's control settles.
+        for _ in 0..40 {
+            engine.process(&[], &mut output);
+        }
+        let made = engine.string_tunings();
+        for note in [45, 52, 64, 71] {
+            engine.process(&[TimedEvent::note_on(0, note, 1.0)], &mut output);
+        }
+        assert_eq!(engine.string_tunings(), made, "nothing tuned on a note-on");
     }
 
     #[test]

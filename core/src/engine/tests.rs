@@ -2,6 +2,7 @@
 //! sample accuracy, block-size independence and smoothing.
 
 use super::render::{render, RenderOptions, Score};
+use super::tuning_memory::PlannedTension;
 use super::*;
 use crate::tanpura::quality::Quality;
 
@@ -775,9 +776,7 @@ fn prepared_tunings_leave_note_ons_nothing_to_tune_and_sound_the_same() {
         .count();
     assert_eq!(playable, 80);
     assert_eq!(prepared.tuning_memory().len(), playable);
-    let tunings =
-        |engine: &Engine| -> u64 { engine.slots.iter().map(|slot| slot.voice.tunings()).sum() };
-    let (prepared_made, tuning_made) = (tunings(&prepared), tunings(&tuning));
+    let (prepared_made, tuning_made) = (prepared.string_tunings(), tuning.string_tunings());
     let phrase = [
         note_on(0, 50),
         note_on(1500, 57),
@@ -787,11 +786,87 @@ fn prepared_tunings_leave_note_ons_nothing_to_tune_and_sound_the_same() {
     let heard = run(&mut prepared, &phrase, 9000);
     let expected = run(&mut tuning, &phrase, 9000);
     assert_eq!(
-        tunings(&prepared),
+        prepared.string_tunings(),
         prepared_made,
         "nothing tuned on a note-on"
     );
-    assert_eq!(tunings(&tuning), tuning_made + 4);
+    assert_eq!(tuning.string_tunings(), tuning_made + 4);
+    let loudest = peak(&expected);
+    assert!(loudest > 1e-3, "{loudest}");
+    let largest = heard
+        .iter()
+        .zip(&expected)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+    assert!(largest <= 1e-5 * loudest, "{largest:e} of {loudest:e}");
+}
+
+/// After a change of the bridge's control the engine hands out one tuning plan, once (and none
+/// for a change of the losses alone, which the tuning does not see). Its strings tuned off the
+/// engine and handed back leave a phrase's note-ons nothing to tune once the control has
+/// settled, and the phrase sounds as from an engine that tunes each string on its note-on (to
+/// round-off); without them every note-on tunes its string.
+#[test]
+fn a_changed_bridge_is_tuned_from_its_plan_off_the_audio_thread() {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Live;
+    let mut planned = Engine::new(&settings, RATE, 4);
+    planned.prepare_tunings();
+    assert_eq!(planned.take_wanted_tuning_plan(), None, "prepared");
+    let mut changed = settings;
+    changed.voice.bridge_stiffness_n_m2 *= 10.0;
+    planned.set_settings(&changed);
+    let plan = planned
+        .take_wanted_tuning_plan()
+        .expect("a plan for the new bridge");
+    assert_eq!(planned.take_wanted_tuning_plan(), None, "handed out once");
+    let mut damped = changed;
+    damped.voice.gamma_per_s *= 2.0;
+    damped.voice.eta_s *= 2.0;
+    planned.set_settings(&damped);
+    assert_eq!(
+        planned.take_wanted_tuning_plan(),
+        None,
+        "the losses need none"
+    );
+
+    // The worker's part.
+    let mut voice = plan.scratch_voice();
+    for string in plan.strings() {
+        planned.remember_tuning(&plan.tune(&mut voice, &string));
+    }
+    let other_rate = PlannedTension {
+        sample_rate_hz: 48_000.0,
+        ..plan.tune(&mut voice, &plan.strings().next().unwrap())
+    };
+    let remembered = planned.tuning_memory().len();
+    planned.remember_tuning(&other_rate);
+    assert_eq!(planned.tuning_memory().len(), remembered, "another rate's");
+    assert!(planned.tuning_memory().covers(&plan));
+    assert_eq!(planned.tuning_plan(), plan);
+
+    let mut tuning = Engine::new(&settings, RATE, 4);
+    tuning.prepare_tunings();
+    tuning.set_settings(&damped);
+    // The controls settle.
+    let settle = (2.0 * SMOOTHING_TIME_S * RATE) as usize;
+    run(&mut planned, &[], settle);
+    run(&mut tuning, &[], settle);
+    let (planned_made, tuning_made) = (planned.string_tunings(), tuning.string_tunings());
+    let phrase = [
+        note_on(0, 45),
+        note_on(1500, 52),
+        note_on(3000, 64),
+        note_on(4500, 71),
+    ];
+    let heard = run(&mut planned, &phrase, 9000);
+    let expected = run(&mut tuning, &phrase, 9000);
+    assert_eq!(
+        planned.string_tunings(),
+        planned_made,
+        "nothing tuned on a note-on"
+    );
+    assert_eq!(tuning.string_tunings(), tuning_made + 4);
     let loudest = peak(&expected);
     assert!(loudest > 1e-3, "{loudest}");
     let largest = heard

@@ -14,14 +14,18 @@
 //!
 //! The memory fills as strings are tuned on note-ons, and [`crate::engine::Engine::prepare_tunings`]
 //! fills it off the audio thread for every note the tuning can play, as a host does when it
-//! activates the plugin. Its entries are keyed by the whole settings, so a change of any
+//! activates the plugin. After a change of what the tuning sees (the bridge, the thread, the
+//! tier, the tuning), the engine hands out the new [`TuningPlan`]
+//! ([`crate::engine::Engine::take_wanted_tuning_plan`]) for a worker to tune off the audio
+//! thread and hand back note by note ([`crate::engine::Engine::remember_tuning`]). Its entries are keyed by the whole settings, so a change of any
 //! setting the tuning sees (the thread, the bridge, the tier, the pitch) finds none and tunes
 //! the string as before; the oldest entry makes room for a new one. A fixed array searched in
 //! order: at most [`TUNING_MEMORY_CAPACITY`] comparisons of a few numbers each, against the
 //! 250 µs a hit saves at the fine tier (configured once in 92–98 µs, tuned in 345–357 µs,
 //! `docs/performance.md`), and nothing allocates after [`TuningMemory::new`].
 
-use crate::tanpura::VoiceSettings;
+use crate::engine::pitch::Tuning;
+use crate::tanpura::{TanpuraVoice, VoiceSettings};
 
 /// Settings remembered at once: every playable note of one tuning (MIDI 16–95 at A4 = 440 Hz)
 /// with room for the drone's strings and calibrated variants.
@@ -51,7 +55,7 @@ impl TuningMemory {
     }
 
     /// The settings as the tuning sees them: clamped, without the losses and the pickup mix.
-    fn key(settings: &VoiceSettings) -> VoiceSettings {
+    pub(crate) fn key(settings: &VoiceSettings) -> VoiceSettings {
         let clamped = settings.clamped();
         let reference = VoiceSettings::default();
         VoiceSettings {
@@ -103,10 +107,81 @@ impl TuningMemory {
         self.entries.is_empty()
     }
 
+    /// Whether a tension is remembered for every string of `plan`.
+    pub fn covers(&self, plan: &TuningPlan) -> bool {
+        plan.strings()
+            .all(|settings| self.tension_n(&settings).is_some())
+    }
+
     /// Forgets every entry. Allocation-free.
     pub fn clear(&mut self) {
         self.entries.clear();
         self.next = 0;
+    }
+}
+
+/// Every playable note's string with one set of settings: what a memory is prepared for
+/// ([`crate::engine::Engine::prepare_tunings`], [`crate::engine::Engine::take_wanted_tuning_plan`]).
+/// Two plans are equal when the tuning sees the same strings in them. Plain data, so the audio
+/// thread can hand it to another thread without allocating.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TuningPlan {
+    /// The strings' settings as the tuning sees them ([`TuningMemory`]'s key), any pitch.
+    base: VoiceSettings,
+    tuning: Tuning,
+    sample_rate_hz: f64,
+}
+
+/// One string of a [`TuningPlan`] and the tension that tunes it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlannedTension {
+    pub settings: VoiceSettings,
+    pub tension_n: f64,
+    pub sample_rate_hz: f64,
+}
+
+impl TuningPlan {
+    /// The plan for strings with `base`'s settings (its pitch aside) at every note `tuning` can
+    /// play, at `sample_rate_hz`.
+    pub fn new(base: &VoiceSettings, tuning: &Tuning, sample_rate_hz: f64) -> Self {
+        Self {
+            base: TuningMemory::key(base),
+            tuning: *tuning,
+            sample_rate_hz,
+        }
+    }
+
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+
+    /// Each playable note's string settings, from the lowest note up.
+    pub fn strings(&self) -> impl Iterator<Item = VoiceSettings> + '_ {
+        (0..=127u8).filter_map(|note| {
+            let hz = self.tuning.playable_note_hz(note)?;
+            Some(
+                VoiceSettings {
+                    fundamental_hz: hz,
+                    ..self.base
+                }
+                .clamped(),
+            )
+        })
+    }
+
+    /// A voice to tune the plan's strings with ([`TuningPlan::tune`]). Allocates.
+    pub fn scratch_voice(&self) -> TanpuraVoice {
+        TanpuraVoice::new(&self.base, self.sample_rate_hz)
+    }
+
+    /// Tunes `settings`' string on `voice` (a fine string: 345–357 µs on a 2.6 GHz Xeon).
+    pub fn tune(&self, voice: &mut TanpuraVoice, settings: &VoiceSettings) -> PlannedTension {
+        voice.set_settings(settings);
+        PlannedTension {
+            settings: *settings,
+            tension_n: voice.tension_n(),
+            sample_rate_hz: self.sample_rate_hz,
+        }
     }
 }
 
