@@ -338,7 +338,10 @@ pub struct ModalString<T: Real> {
     /// with: the finger's centre, width and amplitude, and whether its static solve converged.
     /// A pluck is a static solve from the rest state, not from the motion, so a string plucked
     /// again the same way before its configuration or rest state changes (the drone's strings,
-    /// every cycle) takes it back instead of solving again, to the bit.
+    /// every cycle) takes it back instead of solving again, to the bit. On the nodes, a pluck
+    /// at the same place and width pressed by another amplitude (a humanised drone's) takes
+    /// the solved state shifted along its contact set's line while that set holds
+    /// ([`NodalStatics::shifted_modal`]), the same state as its own solve's to round-off.
     last_press: Option<LastPress>,
     pressed_modal: Vec<f64>,
     /// Presses solved (plucks that did not take the last one's pressed state back).
@@ -361,9 +364,13 @@ struct LastPress {
 impl LastPress {
     /// The same finger, pressed as far: the same pressed state.
     fn same_finger(&self, other: &Self) -> bool {
-        self.centre_m == other.centre_m
-            && self.width_m == other.width_m
-            && self.amplitude_m == other.amplitude_m
+        self.same_place(other) && self.amplitude_m == other.amplitude_m
+    }
+
+    /// The same finger at the same place: the same points, their free gaps shifted by the
+    /// difference of the amplitudes.
+    fn same_place(&self, other: &Self) -> bool {
+        self.centre_m == other.centre_m && self.width_m == other.width_m
     }
 }
 
@@ -1164,19 +1171,42 @@ impl<T: Real> ModalString<T> {
             amplitude_m: amplitude,
             converged: true,
         };
-        match self.last_press {
+        // Only a converged solve on the nodes prepares its shift (below).
+        let shifted = |string: &mut Self, last: &LastPress| {
+            last.converged
+                && string.nodal_in_use
+                && last.same_place(&press)
+                && string.statics.shifted_modal(
+                    amplitude - last.amplitude_m,
+                    &string.pressed_modal[..modes],
+                    &mut string.row[..modes],
+                )
+        };
+        let last_press = self.last_press;
+        match last_press {
             Some(last) if last.same_finger(&press) => {
                 self.row[..modes].copy_from_slice(&self.pressed_modal[..modes]);
                 if !last.converged {
                     self.static_solve_failures += 1;
                 }
             }
+            Some(last) if shifted(self, &last) => {}
             _ => {
                 let failures = self.static_solve_failures;
                 self.press_solves += 1;
                 let top = self.rest_displacement_at_m(centre) + amplitude;
                 if self.nodal_in_use {
-                    self.press_finger_on_nodes(centre, width, top);
+                    // Where the shift does not hold, the same finger at the same place still
+                    // loads the same points: only the finger's gaps change.
+                    let same_place = last_press.is_some_and(|last| last.same_place(&press));
+                    if same_place && self.statics.holds_prepared_shift() {
+                        self.repress_finger_on_nodes(centre, width, top);
+                    } else {
+                        self.press_finger_on_nodes(centre, width, top);
+                    }
+                    if self.static_solve_failures == failures {
+                        self.statics.prepare_shift(self.points.len(), &self.modes);
+                    }
                 } else {
                     self.press_finger_on_points(centre, width, top);
                 }
@@ -1210,6 +1240,27 @@ impl<T: Real> ModalString<T> {
                 let (x, gap) = finger.point(index);
                 statics.add_point(x, gap, spring, 0.0)
             })
+        });
+        if !converged {
+            self.static_solve_failures += 1;
+        }
+        let modes = self.modes.count();
+        self.row[..modes].copy_from_slice(&self.statics.modal[..modes]);
+    }
+
+    /// [`Self::press_finger_on_nodes`] on the problem the last press loaded and prepared (the
+    /// same points, the same nodes' rows and stiffness), with the finger's gaps for `top` and
+    /// the solve started from the last press's forces.
+    fn repress_finger_on_nodes(&mut self, centre: f64, width: f64, top: f64) {
+        let finger = FingerPress::new(&self.config, centre, width, top);
+        let first = self.points.len();
+        for index in 0..grid_points(0.0, width, self.config.finger.spacing_m) {
+            self.statics
+                .set_free_gap(first + index, finger.point(index).1);
+        }
+        let converged = self.statics.solve(&self.modes).unwrap_or_else(|_| {
+            self.statics.clear_solution();
+            false
         });
         if !converged {
             self.static_solve_failures += 1;
@@ -1878,6 +1929,69 @@ mod tests {
                     "condensed {condensed}, step {step}: {a:?} against {b:?}"
                 );
             }
+        }
+    }
+
+    /// On the nodes, plucks at the same place and width pressed by other amplitudes (a
+    /// humanised drone's, within 10 %) take the solved press shifted along its contact set
+    /// instead of solving it: the pressed state is the solve's to 1e-9 of its size, and the
+    /// string plays as one that solves every press. A pluck pressed hard enough to change the
+    /// contact set solves it again, on the problem the last press prepared, to the same
+    /// tolerance.
+    #[test]
+    fn a_pluck_pressed_softer_at_the_same_place_shifts_the_solved_press() {
+        let config = grid_mode_config(0.36e-3, 0.2e-3, true);
+        let base = Pluck::default();
+        let plucks: Vec<Pluck> = [1.0, 0.93, 0.97, 0.9, 0.95]
+            .iter()
+            .map(|&factor| Pluck {
+                amplitude_m: factor * base.amplitude_m,
+                ..base
+            })
+            .chain([Pluck {
+                amplitude_m: 3e-3,
+                ..base
+            }])
+            .collect();
+        let play = |remember: bool| {
+            let mut string = ModalString::<f32>::new(config);
+            assert!(string.nodal_in_use);
+            let modes = string.modes.count();
+            let (mut output, mut pressed) = (Vec::new(), Vec::new());
+            for pluck in &plucks {
+                if !remember {
+                    string.last_press = None;
+                }
+                string.pluck(pluck);
+                pressed.push(string.row[..modes].to_vec());
+                for _ in 0..2000 {
+                    string.step();
+                    output.push((string.nut_force_n(), string.bridge_force_n()));
+                }
+            }
+            (output, pressed, string.press_solves)
+        };
+        let (shifted, shifted_presses, shifted_solves) = play(true);
+        let (solved, solved_presses, solved_solves) = play(false);
+        assert_eq!(solved_solves, 6);
+        assert_eq!(shifted_solves, 2, "the first press and the hard one");
+        for (index, (a, b)) in shifted_presses.iter().zip(&solved_presses).enumerate() {
+            let size = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let largest = a
+                .iter()
+                .zip(b)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(
+                size > 0.0 && largest <= 1e-9 * size,
+                "pluck {index}: {largest:e} of {size:e}"
+            );
+        }
+        let loudest = solved.iter().fold(0.0f64, |m, (nut, bridge)| {
+            m.max(nut.abs()).max(bridge.abs())
+        });
+        for (step, (a, b)) in shifted.iter().zip(&solved).enumerate() {
+            let apart = (a.0 - b.0).abs().max((a.1 - b.1).abs());
+            assert!(apart <= 1e-5 * loudest, "step {step}: {a:?} against {b:?}");
         }
     }
 

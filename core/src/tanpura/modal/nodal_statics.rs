@@ -96,6 +96,13 @@ pub struct NodalStatics {
     factor: DenseCholesky,
     column: Vec<f64>,
     scratch: Vec<f64>,
+    /// After [`Self::prepare_shift`]: per point the penetration `g − u` at the solution and its
+    /// rate under the shift; per mode the modal state's rate.
+    penetrations_m: Vec<f64>,
+    penetration_rates: Vec<f64>,
+    modal_rates: Vec<f64>,
+    /// Whether they are the loaded problem's (a new problem, [`Self::begin`], ends them).
+    shift_ready: bool,
     /// Mode-length scratch for the tuning's iteration.
     product: Vec<f64>,
     iterate: Vec<f64>,
@@ -134,6 +141,10 @@ impl NodalStatics {
             factor: DenseCholesky::with_capacity(nodes),
             column: zeros(nodes),
             scratch: zeros(nodes),
+            penetrations_m: zeros(point_capacity),
+            penetration_rates: zeros(point_capacity),
+            modal_rates: zeros(MODE_CAPACITY),
+            shift_ready: false,
             product: zeros(MODE_CAPACITY),
             iterate: zeros(MODE_CAPACITY),
             inverse_squares: zeros(MODE_CAPACITY),
@@ -151,6 +162,7 @@ impl NodalStatics {
         self.length_m = length_m;
         self.node_count = 0;
         self.point_count = 0;
+        self.shift_ready = false;
     }
 
     /// Adds a point at `x_m` with free gap `free_gap_m`, spring `spring_n_m` and the force
@@ -343,6 +355,92 @@ impl NodalStatics {
         self.spread_forces();
         self.modal_from_nodal_forces(modes);
         Ok(converged)
+    }
+
+    /// After a [`Self::solve`] that converged: how its solution moves when the free gaps of the
+    /// points from `first_shifted` on rise together by t (a finger's points when its top
+    /// rises by t). On the solution's contact set A the problem is linear:
+    /// `(K + Σ_A k_i l_i l_iᵀ) ẏ = Σ_A k_i ġ_i l_i` with the factor of the solve's last Newton
+    /// step (whose contact set was A), each point's penetration `p_i = g_i − l_i · y` moves by
+    /// `ṗ_i = ġ_i − l_i · ẏ`, and the modal state by `ṙ = Vᵀ Σ_A k_i ṗ_i l_i`.
+    /// [`Self::shifted_modal`] then gives the shifted problem's solution while A holds.
+    pub fn prepare_shift(&mut self, first_shifted: usize, modes: &ModeSet) {
+        let (n, count) = (self.node_count, self.point_count);
+        let rises = |i: usize| if i >= first_shifted { 1.0 } else { 0.0 };
+        self.trial_m[..n].fill(0.0);
+        for i in 0..count {
+            let displacement = self.displacements_m[i];
+            self.penetrations_m[i] = self.free_gaps_m[i] - displacement;
+            if self.penetrations_m[i] > 0.0 {
+                let scaled = self.springs_n_m[i] * rises(i);
+                for j in 0..4 {
+                    self.trial_m[self.stencils[i][j]] += scaled * self.weights[i][j];
+                }
+            }
+        }
+        if n > 0 {
+            self.factor.solve_in_place(&mut self.trial_m[..n]);
+        }
+        self.nodal_forces[..n].fill(0.0);
+        for i in 0..count {
+            let rate = rises(i) - self.at_point(i, &self.trial_m);
+            self.penetration_rates[i] = rate;
+            if self.penetrations_m[i] > 0.0 {
+                let scaled = self.springs_n_m[i] * rate;
+                for j in 0..4 {
+                    self.nodal_forces[self.stencils[i][j]] += scaled * self.weights[i][j];
+                }
+            }
+        }
+        self.shift_ready = true;
+        let modes = modes.count();
+        self.modal_rates[..modes].fill(0.0);
+        for j in 0..n {
+            let rate = self.nodal_forces[j];
+            let row = &self.shapes[j * MODE_CAPACITY..j * MODE_CAPACITY + modes];
+            for (value, v) in self.modal_rates[..modes].iter_mut().zip(row) {
+                *value += rate * v;
+            }
+        }
+    }
+
+    /// The modal state of [`Self::prepare_shift`]'s problem shifted by `t`, `r + t ṙ` from the
+    /// solved state `modal` (its [`Self::modal`]), into `shifted`, if every point keeps its
+    /// contact there (`p_i + t ṗ_i > 0` exactly where `p_i > 0`): the solution of the shifted
+    /// problem, the same as its own solve's to round-off. Returns false, writing nothing, where a
+    /// point would change its contact, or the loaded problem is no longer the one prepared. One
+    /// pass over the points and one over the modes.
+    pub fn shifted_modal(&self, t: f64, modal: &[f64], shifted: &mut [f64]) -> bool {
+        if !self.shift_ready {
+            return false;
+        }
+        let count = self.point_count;
+        let keeps = self.penetrations_m[..count]
+            .iter()
+            .zip(&self.penetration_rates[..count])
+            .all(|(&penetration, &rate)| (penetration + t * rate > 0.0) == (penetration > 0.0));
+        if !(keeps && t.is_finite()) {
+            return false;
+        }
+        for ((value, &base), &rate) in shifted.iter_mut().zip(modal).zip(&self.modal_rates) {
+            *value = base + t * rate;
+        }
+        true
+    }
+
+    /// Whether the loaded problem is still the one [`Self::prepare_shift`] prepared (its nodes'
+    /// rows and stiffness prepared, its last solution in place).
+    pub fn holds_prepared_shift(&self) -> bool {
+        self.shift_ready
+    }
+
+    /// Sets point `i`'s free gap, for a [`Self::solve`] of the same points again (from the
+    /// forces of the last solution).
+    pub fn set_free_gap(&mut self, i: usize, free_gap_m: f64) {
+        if i < self.point_count {
+            self.free_gaps_m[i] = free_gap_m;
+            self.shift_ready = false;
+        }
     }
 
     /// The string free of every point (no force, no displacement, r = 0): the state a problem
