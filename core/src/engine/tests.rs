@@ -829,6 +829,16 @@ fn a_changed_bridge_is_tuned_from_its_plan_off_the_audio_thread() {
         None,
         "the losses need none"
     );
+    // Settings that are not numbers are clamped first: one plan, not one per block.
+    let mut broken = damped;
+    broken.voice.bridge_stiffness_n_m2 = f64::NAN;
+    broken.voice.thread_position_m = f64::NAN;
+    broken.tuning.a4_hz = f64::NAN;
+    planned.set_settings(&broken);
+    assert!(planned.take_wanted_tuning_plan().is_some());
+    assert_eq!(planned.take_wanted_tuning_plan(), None, "NaN settings");
+    planned.set_settings(&damped);
+    assert!(planned.take_wanted_tuning_plan().is_some(), "back");
 
     // The worker's part.
     let mut voice = plan.scratch_voice();
