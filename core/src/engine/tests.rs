@@ -776,18 +776,24 @@ fn prepared_tunings_leave_note_ons_nothing_to_tune_and_sound_the_same() {
         .count();
     assert_eq!(playable, 80);
     assert_eq!(prepared.tuning_memory().len(), playable);
-    let (prepared_made, tuning_made) = (prepared.string_tunings(), tuning.string_tunings());
-    let phrase = [
-        note_on(0, 50),
-        note_on(1500, 57),
-        note_on(3000, 62),
-        note_on(4500, 69),
-    ];
-    let heard = run(&mut prepared, &phrase, 9000);
-    let expected = run(&mut tuning, &phrase, 9000);
+    assert_remembers_every_tuning(&mut prepared, &mut tuning, [50, 57, 62, 69]);
+}
+
+/// Plays four notes 1500 samples apart on `remembering` and on `tuning`: `remembering` tunes
+/// no string on their note-ons, `tuning` tunes each, and the two sound the same to 1e-5 of the
+/// louder's peak (round-off).
+fn assert_remembers_every_tuning(remembering: &mut Engine, tuning: &mut Engine, notes: [u8; 4]) {
+    let (remembering_made, tuning_made) = (remembering.string_tunings(), tuning.string_tunings());
+    let phrase: Vec<TimedEvent> = notes
+        .iter()
+        .enumerate()
+        .map(|(index, &note)| note_on(1500 * index, note))
+        .collect();
+    let heard = run(remembering, &phrase, 9000);
+    let expected = run(tuning, &phrase, 9000);
     assert_eq!(
-        prepared.string_tunings(),
-        prepared_made,
+        remembering.string_tunings(),
+        remembering_made,
         "nothing tuned on a note-on"
     );
     assert_eq!(tuning.string_tunings(), tuning_made + 4);
@@ -862,27 +868,5 @@ fn a_changed_bridge_is_tuned_from_its_plan_off_the_audio_thread() {
     let settle = (2.0 * SMOOTHING_TIME_S * RATE) as usize;
     run(&mut planned, &[], settle);
     run(&mut tuning, &[], settle);
-    let (planned_made, tuning_made) = (planned.string_tunings(), tuning.string_tunings());
-    let phrase = [
-        note_on(0, 45),
-        note_on(1500, 52),
-        note_on(3000, 64),
-        note_on(4500, 71),
-    ];
-    let heard = run(&mut planned, &phrase, 9000);
-    let expected = run(&mut tuning, &phrase, 9000);
-    assert_eq!(
-        planned.string_tunings(),
-        planned_made,
-        "nothing tuned on a note-on"
-    );
-    assert_eq!(tuning.string_tunings(), tuning_made + 4);
-    let loudest = peak(&expected);
-    assert!(loudest > 1e-3, "{loudest}");
-    let largest = heard
-        .iter()
-        .zip(&expected)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0f32, f32::max);
-    assert!(largest <= 1e-5 * loudest, "{largest:e} of {loudest:e}");
+    assert_remembers_every_tuning(&mut planned, &mut tuning, [45, 52, 64, 71]);
 }
