@@ -104,10 +104,9 @@ impl Drop for TuningWorker {
     }
 }
 
-/// A tuning plan being tuned: its scratch voice and the strings left, the next last.
+/// A tuning plan being tuned: the strings left, the next last.
 struct PlanInProgress {
     plan: TuningPlan,
-    voice: TanpuraVoice,
     strings_left: Vec<VoiceSettings>,
 }
 
@@ -115,17 +114,16 @@ impl PlanInProgress {
     fn new(plan: TuningPlan) -> Self {
         let mut strings_left: Vec<_> = plan.strings().collect();
         strings_left.reverse();
-        Self {
-            plan,
-            voice: plan.scratch_voice(),
-            strings_left,
-        }
+        Self { plan, strings_left }
     }
 }
 
 fn run(shared: &Shared) {
     let mut remembered: Vec<Calibration> = Vec::with_capacity(REMEMBERED);
     let mut in_progress: Option<PlanInProgress> = None;
+    // Kept from plan to plan at one output rate (a knob turned for a while sends a plan every
+    // block): a string is tuned on it whatever its last settings were.
+    let mut scratch: Option<(f64, TanpuraVoice)> = None;
     while !shared.stop.load(Ordering::Relaxed) {
         // Calibrations first: they are for strings being played.
         if let Some((request, rate)) = shared.requests.pop() {
@@ -147,7 +145,17 @@ fn run(shared: &Shared) {
             in_progress = None;
             continue;
         };
-        let tuned = progress.plan.tune(&mut progress.voice, &string);
+        let rate = progress.plan.sample_rate_hz();
+        if scratch
+            .as_ref()
+            .is_none_or(|(built_for, _)| *built_for != rate)
+        {
+            scratch = Some((rate, progress.plan.scratch_voice()));
+        }
+        let Some((_, voice)) = &mut scratch else {
+            continue;
+        };
+        let tuned = progress.plan.tune(voice, &string);
         if !push_when_room(shared, &shared.tensions, tuned) {
             return;
         }

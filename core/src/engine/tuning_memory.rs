@@ -17,9 +17,11 @@
 //! activates the plugin. After a change of what the tuning sees (the bridge, the thread, the
 //! tier, the tuning), the engine hands out the new [`TuningPlan`]
 //! ([`crate::engine::Engine::take_wanted_tuning_plan`]) for a worker to tune off the audio
-//! thread and hand back note by note ([`crate::engine::Engine::remember_tuning`]). Its entries are keyed by the whole settings, so a change of any
-//! setting the tuning sees (the thread, the bridge, the tier, the pitch) finds none and tunes
-//! the string as before; the oldest entry makes room for a new one. A fixed array searched in
+//! thread and hand back note by note ([`crate::engine::Engine::remember_tuning`]).
+//!
+//! Entries are keyed by the whole settings, so a change of any setting the tuning sees (the
+//! thread, the bridge, the tier, the pitch) finds none and tunes the string as before, until a
+//! plan's tensions arrive; the oldest entry makes room for a new one. A fixed array searched in
 //! order: at most [`TUNING_MEMORY_CAPACITY`] comparisons of a few numbers each, against the
 //! 250 µs a hit saves at the fine tier (configured once in 92–98 µs, tuned in 345–357 µs,
 //! `docs/performance.md`), and nothing allocates after [`TuningMemory::new`].
@@ -151,6 +153,7 @@ impl TuningPlan {
         }
     }
 
+    /// The output rate the plan's strings play at, Hz.
     pub fn sample_rate_hz(&self) -> f64 {
         self.sample_rate_hz
     }
