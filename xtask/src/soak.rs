@@ -638,6 +638,8 @@ impl SoakScene {
                 engine.set_settings(settings);
                 engine.set_host_tempo(tempo);
                 engine.process(events, output);
+                // As the plugin's tuning worker takes it after every block.
+                let _ = engine.take_wanted_tuning_plan();
             })
         });
         self.counts.allocations += allocations;
