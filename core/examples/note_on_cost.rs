@@ -10,6 +10,9 @@
 //!    (`Engine::prepare_tunings`, as the plugin prepares it on activation): the slowest blocks
 //!    (each block's fastest time over the runs, as the bench takes it) as a share of the
 //!    64-sample deadline at 44.1 kHz, and the real-time factor.
+//! 3. A tuning plan's strings tuned as the plugin's tuning worker tunes them after a change of
+//!    the bridge or thread control (`Engine::take_wanted_tuning_plan`), off the audio thread:
+//!    the time for all of them on one scratch voice.
 
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TimedEvent};
@@ -36,6 +39,24 @@ fn main() {
     for prepared in [false, true] {
         eight_voices(quality, runs, prepared, deadline_us);
     }
+    plan_cost(quality);
+}
+
+/// Part 3: a tuning plan's strings, tuned on one scratch voice.
+fn plan_cost(quality: Quality) {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = quality;
+    let plan = Engine::new(&settings, SAMPLE_RATE, 1).tuning_plan();
+    let start = Instant::now();
+    let mut voice = plan.scratch_voice();
+    let count = plan
+        .strings()
+        .map(|string| std::hint::black_box(plan.tune(&mut voice, &string)))
+        .count();
+    println!(
+        "a tuning plan, off the audio thread: {count} strings in {:.1} ms",
+        start.elapsed().as_secs_f64() * 1e3
+    );
 }
 
 /// Part 1: the mean cost of each stage of a note-on on one voice, µs.

@@ -1,7 +1,7 @@
 //! The tanpura's audio path allocates nothing, under a counting global allocator:
 //!
 //! - 10 000 output samples of the four-string instrument at every quality tier (modal and FD,
-//!   with plucks and a retune in between);
+//!   with plucks, humanised plucks and a retune in between);
 //! - a note-on through the engine, whether the engine's tuning memory knows its string's
 //!   settings (the string configured at the remembered tension) or not (the string tuned, and
 //!   its tension remembered, the oldest entry making room once the memory is full): 140
@@ -74,7 +74,21 @@ fn four_strings_allocate_nothing(quality: Quality) {
     for index in 0..4 {
         tanpura.pluck(index, &Pluck::default());
     }
+    // Humanised plucks: softer at the same place (the modal strings on the nodes shift their
+    // last press), and a hard one (solved again on the press's problem).
+    let softer = Pluck {
+        amplitude_m: 0.93 * Pluck::default().amplitude_m,
+        ..Pluck::default()
+    };
+    let hard = Pluck {
+        amplitude_m: 3e-3,
+        ..Pluck::default()
+    };
     for sample in 0..10_000 {
+        if sample == 2_500 {
+            tanpura.pluck(0, &softer);
+            tanpura.pluck(2, &hard);
+        }
         if sample == 5_000 {
             tanpura.set_tuning(&retuned, 155.6, FirstString::Ma);
             tanpura.pluck(1, &Pluck::default());

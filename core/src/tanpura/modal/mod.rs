@@ -1171,17 +1171,6 @@ impl<T: Real> ModalString<T> {
             amplitude_m: amplitude,
             converged: true,
         };
-        // Only a converged solve on the nodes prepares its shift (below).
-        let shifted = |string: &mut Self, last: &LastPress| {
-            last.converged
-                && string.nodal_in_use
-                && last.same_place(&press)
-                && string.statics.shifted_modal(
-                    amplitude - last.amplitude_m,
-                    &string.pressed_modal[..modes],
-                    &mut string.row[..modes],
-                )
-        };
         let last_press = self.last_press;
         match last_press {
             Some(last) if last.same_finger(&press) => {
@@ -1190,7 +1179,7 @@ impl<T: Real> ModalString<T> {
                     self.static_solve_failures += 1;
                 }
             }
-            Some(last) if shifted(self, &last) => {}
+            Some(last) if self.shift_last_press(&last, &press) => {}
             _ => {
                 let failures = self.static_solve_failures;
                 self.press_solves += 1;
@@ -1246,6 +1235,21 @@ impl<T: Real> ModalString<T> {
         }
         let modes = self.modes.count();
         self.row[..modes].copy_from_slice(&self.statics.modal[..modes]);
+    }
+
+    /// The pressed state of `press` into `row` from the `last` one's, shifted along its contact
+    /// set ([`NodalStatics::shifted_modal`]), if `press` is at the same place and the set
+    /// holds. The static solver holds a prepared shift only after a converged press on the
+    /// nodes (`pluck`), until it poses another problem.
+    fn shift_last_press(&mut self, last: &LastPress, press: &LastPress) -> bool {
+        let modes = self.modes.count();
+        self.nodal_in_use
+            && last.same_place(press)
+            && self.statics.shifted_modal(
+                press.amplitude_m - last.amplitude_m,
+                &self.pressed_modal[..modes],
+                &mut self.row[..modes],
+            )
     }
 
     /// [`Self::press_finger_on_nodes`] on the problem the last press loaded and prepared (the
