@@ -13,9 +13,10 @@
 //! Between calibrations the worker tunes the strings of the engine's latest tuning plan: after
 //! a change of what the tuning sees (the bridge, the thread, the tier, the tuning), the engine
 //! hands out the new plan (`Engine::take_wanted_tuning_plan`), and the worker tunes every
-//! playable note's string with it and hands the tensions back one by one
-//! (`Engine::remember_tuning`), so that the notes played after the change configure their
-//! strings instead of tuning them on the audio thread. A newer plan replaces one in progress.
+//! string in it (in drone mode the drone's strings on its Sa first, then every playable note's)
+//! and hands the tensions back one by one (`Engine::remember_tuning`), so that the strings
+//! plucked after the change configure their strings instead of tuning them on the audio thread.
+//! A newer plan replaces one in progress.
 //!
 //! Every direction is a lock-free fixed-size queue (`crossbeam::queue::ArrayQueue`): the audio
 //! thread only pushes and pops, never waits, locks or allocates (a full request queue drops the

@@ -625,6 +625,9 @@ pub struct Engine {
     /// The last plan the memory was prepared for or handed out to be
     /// ([`Engine::take_wanted_tuning_plan`]).
     planned: Option<TuningPlan>,
+    /// The Sa the drone last plucked on, whose strings the tuning plan holds while no Sa is set
+    /// in the settings (a held note's drone keeps its tensions after the note is released).
+    last_drone_sa: Option<u8>,
 }
 
 /// Calibration requests an engine keeps until they are taken.
@@ -711,6 +714,7 @@ impl Engine {
             wanted: [None; WANTED_CAPACITY],
             tunings: TuningMemory::new(),
             planned: None,
+            last_drone_sa: None,
         };
         engine.apply_bowed_settings();
         engine
@@ -1249,24 +1253,48 @@ impl Engine {
     }
 
     /// The notes' strings once the smoothed controls reach their targets, as the tuning sees
-    /// them ([`TuningPlan`]). Takes `&mut self` only because it reads the controls' targets
-    /// through the accessor that also steps them. Allocation-free.
+    /// them ([`TuningPlan`]), and in drone mode the drone's strings on its Sa (the settings'
+    /// Sa, else the one it last plucked on). Takes `&mut self` only because it reads the
+    /// controls' targets through the accessor that also steps them. Allocation-free.
     pub fn tuning_plan(&mut self) -> TuningPlan {
         let controls = self.smoothed_controls(|control| control.target());
-        TuningPlan::new(
+        let plan = TuningPlan::new(
             &self.voice_with_controls(controls),
             &self.target.tuning,
             self.sample_rate_hz,
+        );
+        let drone = self.target.drone;
+        let Some(sa_note) = drone
+            .sa_note
+            .or(self.last_drone_sa)
+            .filter(|_| drone.enabled)
+        else {
+            return plan;
+        };
+        let sa_hz = self.target.tuning.note_hz(sa_note);
+        let (ratios, count) = string_ratios(drone.first_string, drone.pattern);
+        plan.with_drone_strings(
+            ratios
+                .iter()
+                .zip(&drone.strings)
+                .take(count)
+                // The pitch as the drone's pluck forms it, to the bit.
+                .map(|(ratio, string)| {
+                    (
+                        sa_hz * ratio * string.fine_tune_ratio(),
+                        string.thread_offset_m,
+                    )
+                }),
         )
     }
 
     /// The plan whose tensions the memory lacks, once after each change of what the tuning sees
-    /// (the bridge's or the thread's control, the tier, the tuning, the sample rate), for a
-    /// worker to tune off the audio thread and hand back through [`Engine::remember_tuning`];
-    /// `None` while nothing changed since the last plan prepared or handed out, and while the
-    /// bowed string plays. Without it each note's first pluck after such a change tunes its
-    /// string on the audio thread: 345–357 µs at the fine tier against 92–98 µs to configure
-    /// it (`tuning_memory.rs`). Allocation-free.
+    /// (the bridge's or the thread's control, the tier, the tuning, the sample rate, the drone's
+    /// Sa or its strings), for a worker to tune off the audio thread and hand back through
+    /// [`Engine::remember_tuning`]; `None` while nothing changed since the last plan prepared or
+    /// handed out, and while the bowed string plays. Without it each string's first pluck after
+    /// such a change tunes it on the audio thread: 345–357 µs at the fine tier against
+    /// 92–98 µs to configure it (`tuning_memory.rs`). Allocation-free.
     pub fn take_wanted_tuning_plan(&mut self) -> Option<TuningPlan> {
         if self.target.instrument != Instrument::Tanpura {
             return None;
@@ -1447,6 +1475,7 @@ impl Engine {
         let Some(sa_note) = drone.sa_note.or_else(|| self.drone.sa_note()) else {
             return;
         };
+        self.last_drone_sa = Some(sa_note);
         let (ratios, _) = string_ratios(drone.first_string, drone.pattern);
         let hz = self.target.tuning.note_hz(sa_note)
             * ratios[pluck.string]

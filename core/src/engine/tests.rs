@@ -2,7 +2,7 @@
 //! sample accuracy, block-size independence and smoothing.
 
 use super::render::{render, RenderOptions, Score};
-use super::tuning_memory::PlannedTension;
+use super::tuning_memory::{PlannedTension, TuningMemory, TuningPlan};
 use super::*;
 use crate::tanpura::quality::Quality;
 
@@ -869,4 +869,114 @@ fn a_changed_bridge_is_tuned_from_its_plan_off_the_audio_thread() {
     run(&mut planned, &[], settle);
     run(&mut tuning, &[], settle);
     assert_remembers_every_tuning(&mut planned, &mut tuning, [45, 52, 64, 71]);
+}
+
+/// In drone mode the tuning plan holds the drone's strings on its Sa, each with its own fine
+/// tuning and thread, ahead of the notes': the Sa of a held note joins the plan at its first
+/// pluck and stays in it after the note is released, and a change of the bridge hands out a plan
+/// with them. Tuned off the engine and handed back, they leave the drone's plucks nothing to
+/// tune; an engine that gets no tensions back tunes each string at its pluck (but Sa's, whose
+/// string is note 50's, prepared with the notes).
+#[test]
+fn the_drones_strings_are_tuned_from_the_plan_off_the_audio_thread() {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Live;
+    settings.drone.enabled = true;
+    settings.drone.strings[0].fine_tune_cents = -13.0;
+    settings.drone.strings[0].thread_offset_m = 0.002;
+    settings.drone.strings[2].fine_tune_cents = 4.0;
+    settings.drone.strings[3].thread_offset_m = -0.001;
+    let beat = 22_050; // at 120 beats per minute
+    let started = || {
+        let mut engine = Engine::new(&settings, RATE, 4);
+        engine.set_host_tempo(Some(120.0));
+        engine.prepare_tunings();
+        engine
+    };
+    let tune_off_the_engine = |engine: &mut Engine, plan: &TuningPlan| {
+        let mut voice = plan.scratch_voice();
+        for string in plan.strings() {
+            engine.remember_tuning(&plan.tune(&mut voice, &string));
+        }
+    };
+    let (mut planned, mut unplanned) = (started(), started());
+    let notes_only = planned.tuning_plan();
+    assert_eq!(
+        planned.take_wanted_tuning_plan(),
+        None,
+        "prepared, no Sa yet"
+    );
+
+    // The held note's first pluck (the first string, tuned as it is plucked) brings its Sa in.
+    let (planned_made, unplanned_made) = (planned.string_tunings(), unplanned.string_tunings());
+    let hold = [note_on(0, 50)];
+    run(&mut planned, &hold, 64);
+    run(&mut unplanned, &hold, 64);
+    assert_eq!(planned.string_tunings(), planned_made + 1);
+    let plan = planned
+        .take_wanted_tuning_plan()
+        .expect("a plan with the drone's strings");
+    assert_eq!(
+        plan.strings().count(),
+        notes_only.strings().count() + 3,
+        "Sa's own string is note 50's"
+    );
+    tune_off_the_engine(&mut planned, &plan);
+    run(&mut planned, &[], 4 * beat);
+    run(&mut unplanned, &[], 4 * beat);
+    let played: Vec<VoiceSettings> = (0..4)
+        .map(|string| {
+            let slot = planned
+                .slots
+                .iter()
+                .find(|slot| slot.key == Some(StringKey::Drone(string)))
+                .expect("each string plucked");
+            TuningMemory::key(slot.voice.settings())
+        })
+        .collect();
+    let planned_drone: Vec<VoiceSettings> = plan.strings().take(4).collect();
+    assert_eq!(
+        planned_drone, played,
+        "the plan's drone strings are the plucked ones, first"
+    );
+    assert_eq!(
+        planned.string_tunings(),
+        planned_made + 1,
+        "the other three from the plan"
+    );
+    assert_eq!(
+        unplanned.string_tunings(),
+        unplanned_made + 3,
+        "Sa's string was prepared as note 50's"
+    );
+
+    // Released (and silenced, so that no string follows the bridge's glide as it rings), the Sa
+    // stays planned; a changed bridge plans the drone's strings anew.
+    let release = [TimedEvent {
+        offset: 0,
+        event: EngineEvent::AllSoundOff,
+    }];
+    run(&mut planned, &release, 64);
+    run(&mut unplanned, &release, 64);
+    assert_eq!(planned.take_wanted_tuning_plan(), None, "released");
+    let mut changed = settings;
+    changed.voice.bridge_stiffness_n_m2 *= 10.0;
+    planned.set_settings(&changed);
+    unplanned.set_settings(&changed);
+    let plan = planned
+        .take_wanted_tuning_plan()
+        .expect("a plan for the new bridge");
+    tune_off_the_engine(&mut planned, &plan);
+    let settle = (2.0 * SMOOTHING_TIME_S * RATE) as usize;
+    run(&mut planned, &[], settle);
+    run(&mut unplanned, &[], settle);
+    let (planned_made, unplanned_made) = (planned.string_tunings(), unplanned.string_tunings());
+    run(&mut planned, &hold, 4 * beat);
+    run(&mut unplanned, &hold, 4 * beat);
+    assert_eq!(
+        planned.string_tunings(),
+        planned_made,
+        "nothing tuned at the drone's plucks"
+    );
+    assert_eq!(unplanned.string_tunings(), unplanned_made + 4);
 }

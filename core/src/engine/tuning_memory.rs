@@ -15,9 +15,11 @@
 //! The memory fills as strings are tuned on note-ons, and [`crate::engine::Engine::prepare_tunings`]
 //! fills it off the audio thread for every note the tuning can play, as a host does when it
 //! activates the plugin. After a change of what the tuning sees (the bridge, the thread, the
-//! tier, the tuning), the engine hands out the new [`TuningPlan`]
+//! tier, the tuning, the drone's Sa or its strings), the engine hands out the new [`TuningPlan`]
 //! ([`crate::engine::Engine::take_wanted_tuning_plan`]) for a worker to tune off the audio
-//! thread and hand back note by note ([`crate::engine::Engine::remember_tuning`]).
+//! thread and hand back string by string ([`crate::engine::Engine::remember_tuning`]). In drone
+//! mode the plan holds the drone's strings on its Sa first (each with its own fine tuning and
+//! thread, so most are no note's string): they are the ones ringing.
 //!
 //! Entries are keyed by the whole settings, so a change of any setting the tuning sees (the
 //! thread, the bridge, the tier, the pitch) finds none and tunes the string as before, until a
@@ -26,6 +28,7 @@
 //! 250 µs a hit saves at the fine tier (configured once in 92–98 µs, tuned in 345–357 µs,
 //! `docs/performance.md`), and nothing allocates after [`TuningMemory::new`].
 
+use crate::engine::drone::MAX_DRONE_STRINGS;
 use crate::engine::pitch::Tuning;
 use crate::tanpura::{TanpuraVoice, VoiceSettings};
 
@@ -122,16 +125,19 @@ impl TuningMemory {
     }
 }
 
-/// Every playable note's string with one set of settings: what a memory is prepared for
-/// ([`crate::engine::Engine::prepare_tunings`], [`crate::engine::Engine::take_wanted_tuning_plan`]).
-/// Two plans are equal when the tuning sees the same strings in them. Plain data, so the audio
-/// thread can hand it to another thread without allocating.
+/// Every playable note's string with one set of settings, and the drone's strings on its Sa:
+/// what a memory is prepared for ([`crate::engine::Engine::prepare_tunings`],
+/// [`crate::engine::Engine::take_wanted_tuning_plan`]). Two plans are equal when the tuning sees
+/// the same strings in them. Plain data, so the audio thread can hand it to another thread
+/// without allocating.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TuningPlan {
     /// The strings' settings as the tuning sees them ([`TuningMemory`]'s key), any pitch.
     base: VoiceSettings,
     tuning: Tuning,
     sample_rate_hz: f64,
+    /// The drone's strings as the tuning sees them, in playing order (none out of drone mode).
+    drone: [Option<VoiceSettings>; MAX_DRONE_STRINGS],
 }
 
 /// One string of a [`TuningPlan`] and the tension that tunes it.
@@ -150,7 +156,25 @@ impl TuningPlan {
             base: TuningMemory::key(base),
             tuning: *tuning,
             sample_rate_hz,
+            drone: [None; MAX_DRONE_STRINGS],
         }
+    }
+
+    /// The same plan with the drone's strings too, each at its pitch and with its thread moved
+    /// by its offset from the base's (as [`crate::engine::Engine`] plucks them); a pitch outside
+    /// [`VoiceSettings::FUNDAMENTAL_RANGE_HZ`] is not played, so not planned.
+    pub fn with_drone_strings(mut self, strings: impl IntoIterator<Item = (f64, f64)>) -> Self {
+        let (low, high) = VoiceSettings::FUNDAMENTAL_RANGE_HZ;
+        for (slot, (fundamental_hz, thread_offset_m)) in self.drone.iter_mut().zip(strings) {
+            *slot = (low..=high).contains(&fundamental_hz).then(|| {
+                TuningMemory::key(&VoiceSettings {
+                    fundamental_hz,
+                    thread_position_m: self.base.thread_position_m + thread_offset_m,
+                    ..self.base
+                })
+            });
+        }
+        self
     }
 
     /// The output rate the plan's strings play at, Hz.
@@ -158,9 +182,16 @@ impl TuningPlan {
         self.sample_rate_hz
     }
 
-    /// Each playable note's string settings, from the lowest note up.
+    /// The drone's strings in playing order (they are the ones ringing), then each playable
+    /// note's string from the lowest note up, each once.
     pub fn strings(&self) -> impl Iterator<Item = VoiceSettings> + '_ {
-        (0..=127u8).filter_map(|note| {
+        let drone = self
+            .drone
+            .iter()
+            .enumerate()
+            .filter(|&(index, string)| !self.drone[..index].contains(string))
+            .filter_map(|(_, string)| *string);
+        let notes = (0..=127u8).filter_map(|note| {
             let hz = self.tuning.playable_note_hz(note)?;
             Some(
                 VoiceSettings {
@@ -169,7 +200,11 @@ impl TuningPlan {
                 }
                 .clamped(),
             )
-        })
+        });
+        drone.chain(notes.filter(|note| {
+            let key = TuningMemory::key(note);
+            !self.drone.contains(&Some(key))
+        }))
     }
 
     /// A voice to tune the plan's strings with ([`TuningPlan::tune`]). Allocates.
