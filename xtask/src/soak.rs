@@ -14,7 +14,7 @@
 //!   humanize seed, bow model, bowed string, body, thread, bridge beyond thread), and the host
 //!   tempo; one change in [`HOSTILE_FRACTION`] sends
 //!   a value no host should (NaN, ±∞, or far out of range), which the engine must clamp;
-//! - the quality tier stays at `--quality` (the plugin's default, live), unless
+//! - the quality tier stays at `--quality` (the plugin's default, fine), unless
 //!   `--automate-quality` adds tier switches to the automation.
 //!
 //! Reported per window of simulated time (`--window-s`): the worst and the 99.9th-percentile
@@ -57,7 +57,7 @@ pub struct SoakArgs {
     #[arg(long, value_name = "S", default_value_t = 1)]
     seed: u64,
     /// Quality tier: draft, live, fine (the plugin's default), studio or reference.
-    #[arg(long, value_name = "TIER", default_value = "live", value_parser = quality_name)]
+    #[arg(long, value_name = "TIER", default_value = "fine", value_parser = quality_name)]
     quality: Quality,
     /// Automate the quality tier too (switches among all four tiers).
     #[arg(long)]
@@ -898,13 +898,13 @@ pub fn run(args: SoakArgs) -> Result<(), Box<dyn Error>> {
 mod tests {
     use super::*;
 
-    /// The soak's loop for a few simulated seconds: notes played, parameters changed (hostile
-    /// values included), no allocation on the audio path, no non-finite sample; the same seed
-    /// replays the same output and another seed does not.
+    /// The soak's loop for a few simulated seconds at the plugin's default tier: notes played,
+    /// parameters changed (hostile values included), no allocation on the audio path, no
+    /// non-finite sample; the same seed replays the same output and another seed does not.
     #[test]
     fn a_short_soak_allocates_nothing_and_stays_finite() {
         let run = |seed| {
-            let mut scene = SoakScene::new(seed, Quality::Live, false, CHANGES_PER_SECOND);
+            let mut scene = SoakScene::new(seed, Quality::Fine, false, CHANGES_PER_SECOND);
             let windows = run_scene(&mut scene, 6.0, 2.0, |_, _| {});
             assert_eq!(windows.len(), 3);
             scene.counts

@@ -126,6 +126,10 @@ fn tier_latency(slots: &[Slot], settings: &EngineSettings) -> usize {
 
 /// Samples between two updates of the strings' smoothed settings.
 pub const CONTROL_INTERVAL: u64 = 32;
+/// Samples at least between two retunes of ringing strings to the smoothed settings (every other
+/// control tick): a retune at the fine tier costs about a fifth of a 64-sample block's deadline,
+/// so that a glide's retunes add at most one to each block (`Engine::control_tick`).
+pub const RETUNE_INTERVAL: u64 = 2 * CONTROL_INTERVAL;
 /// Time a continuous setting takes to reach a new value, s.
 pub const SMOOTHING_TIME_S: f64 = 0.02;
 /// The stereo width a new engine has (0–1).
@@ -602,6 +606,8 @@ pub struct Engine {
     /// Whether a ringing string may still lack the current settings (set when they change,
     /// cleared by a control tick that finds none to retune).
     retune_pending: bool,
+    /// The sample from which a ringing string may be retuned again ([`RETUNE_INTERVAL`]).
+    next_retune: u64,
     /// Each drone string's level as an amplitude factor (from the settings, once per change).
     drone_levels: [f64; drone::MAX_DRONE_STRINGS],
     /// Brings the bowed string (no latency of its own) up to it.
@@ -705,6 +711,7 @@ impl Engine {
             latency,
             retune_cursor: 0,
             retune_pending: false,
+            next_retune: 0,
             drone_levels: settings.drone.strings.map(|string| string.level_factor()),
             bowed_delay: OutputDelay::new(latency),
             scratch: Vec::new(),
@@ -978,6 +985,7 @@ impl Engine {
         self.clock = 0;
         self.next_control_tick = 0;
         self.retune_cursor = 0;
+        self.next_retune = 0;
         for instrument in &mut self.bowed {
             instrument.reset();
         }
@@ -1343,16 +1351,20 @@ impl Engine {
             self.retune_pending = true;
         }
         self.current_voice = settings;
-        if !self.retune_pending {
+        if !self.retune_pending || self.clock < self.next_retune {
             return;
         }
-        // At most one ringing string takes the new settings per control tick, the next in turn
-        // whose settings differ: retuning a string (a new rest state and its linearised
-        // fundamental) costs about a ninth of a 64-sample block's deadline at the live tier
-        // (169 µs, studio 739 µs: `--example retune_cost`), so retuning every string at every
-        // tick of a glide of k_b or the thread missed the deadline several times over (the
-        // soak). With eight strings ringing each follows a glide every eight ticks (5.8 ms at
-        // 44.1 kHz) and reaches the target at most that late.
+        // At most one ringing string takes the new settings every [`RETUNE_INTERVAL`] samples
+        // (every other control tick), the next in turn whose settings differ: retuning a string
+        // (a new rest state and its linearised fundamental) costs about a ninth of a 64-sample
+        // block's deadline at the live tier (169 µs, studio 739 µs: `--example retune_cost`)
+        // and about a fifth at the fine tier (315 µs, `--example note_on_cost`), so retuning
+        // every string at every tick of a glide of k_b or the thread missed the deadline
+        // several times over (the soak), and one at every tick still lifted the fine tier's
+        // slowest blocks under automation by a third (`docs/performance.md`, stop 54). With
+        // eight strings ringing each follows a glide every sixteen ticks (11.6 ms at 44.1 kHz)
+        // and reaches the target at most that late. On the sample clock, so the same whatever
+        // the host's block size.
         let count = self.slots.len();
         for step in 0..count {
             let index = (self.retune_cursor + step) % count;
@@ -1377,6 +1389,7 @@ impl Engine {
             }
             slot.voice.set_settings(&string_settings);
             self.retune_cursor = (index + 1) % count;
+            self.next_retune = self.clock + RETUNE_INTERVAL;
             return;
         }
         // Every ringing string has the settings: nothing to look at until they change.

@@ -535,7 +535,8 @@ fn the_first_drone_string_sounds_on_the_left_and_the_last_on_the_right() {
 }
 
 #[test]
-fn a_glide_retunes_one_ringing_string_per_control_tick_and_every_string_reaches_the_target() {
+fn a_glide_retunes_one_ringing_string_every_other_control_tick_and_every_string_reaches_the_target()
+{
     let mut settings = EngineSettings::default();
     settings.voice.quality = Quality::Draft;
     let mut engine = Engine::new(&settings, RATE, 4);
@@ -555,13 +556,23 @@ fn a_glide_retunes_one_ringing_string_per_control_tick_and_every_string_reaches_
             .map(|slot| slot.voice.settings().thread_position_m)
             .collect()
     };
-    let ticks = (SMOOTHING_TIME_S * RATE / CONTROL_INTERVAL as f64).ceil() as usize + 4;
+    // The glide's ticks, then a round of the four strings at one retune every other tick.
+    let ticks_per_retune = (RETUNE_INTERVAL / CONTROL_INTERVAL) as usize;
+    let ticks =
+        (SMOOTHING_TIME_S * RATE / CONTROL_INTERVAL as f64).ceil() as usize + 4 * ticks_per_retune;
     let mut before = threads(&engine);
+    let mut last_retune: Option<usize> = None;
     for tick in 0..ticks {
         run(&mut engine, &[], CONTROL_INTERVAL as usize);
         let after = threads(&engine);
         let changed = before.iter().zip(&after).filter(|(a, b)| a != b).count();
         assert!(changed <= 1, "tick {tick}: {changed} strings retuned");
+        if changed == 1 {
+            if let Some(last) = last_retune {
+                assert!(tick - last >= 2, "retunes at ticks {last} and {tick}");
+            }
+            last_retune = Some(tick);
+        }
         before = after;
     }
     for (index, thread) in threads(&engine).iter().enumerate() {
