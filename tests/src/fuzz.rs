@@ -11,7 +11,9 @@
 //!   parameter inside its range, finite engine settings, and a state that saves without panic;
 //! - [`engine_events`]: bytes decoded ([`arbitrary`]) into settings, then a stream of events,
 //!   parameter changes, tempo changes, resets and blocks → `Engine::process`: finite output
-//!   within ±[`ENGINE_OUTPUT_BOUND`], and no allocation in any call the audio thread makes.
+//!   within ±[`ENGINE_OUTPUT_BOUND`], and no allocation in any call the audio thread makes (the
+//!   tuning worker's exchange after each block among them: the wanted tuning plan taken, its
+//!   first strings' tensions handed back).
 //!
 //! No allocation is checked as the plugin's tests check it: each call runs inside
 //! `nice_assert_no_alloc::assert_no_alloc`, and the binary's global allocator (nice-plug's, with
@@ -31,7 +33,7 @@ use javari_core::engine::{
 };
 use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
-use javari_core::tanpura::FirstString;
+use javari_core::tanpura::{FirstString, TanpuraVoice};
 use nice_assert_no_alloc::assert_no_alloc;
 
 /// The MIDI target's check (see the module doc).
@@ -138,6 +140,9 @@ const MAX_OPERATIONS: usize = 64;
 const SAMPLE_RATE_HZ: f64 = 44_100.0;
 /// Voices of the fuzzed engine (fewer than the plugin's eight, so that runs stay short).
 const VOICES: usize = 4;
+/// A handed-out tuning plan's strings tuned and handed back after a block (the drone's first, in
+/// drone mode); the plugin's worker tunes them all.
+const PLANNED_STRINGS_TUNED: usize = 2;
 
 /// A number from the fuzzer: mostly near the useful range, sometimes anything (NaN, ±∞, huge).
 #[derive(Debug, Clone, Copy, Arbitrary)]
@@ -369,6 +374,8 @@ pub fn engine_events(bytes: &[u8]) {
     // Left (or mono) and right halves.
     let mut output = vec![0.0f32; 2 * MAX_SAMPLES_PER_INPUT];
     let mut events: Vec<TimedEvent> = Vec::with_capacity(256);
+    // The tuning worker's voice (`plugin/src/tuning_worker.rs`), built at the first plan.
+    let mut scratch: Option<TanpuraVoice> = None;
     let mut rendered = 0;
     for _ in 0..MAX_OPERATIONS {
         let Ok(operation) = Operation::arbitrary(&mut input) else {
@@ -406,6 +413,15 @@ pub fn engine_events(bytes: &[u8]) {
                         "sample {} of the block is {sample}",
                         rendered + index
                     );
+                }
+                // The plugin's worker exchange after the block: the wanted tuning plan, its first
+                // strings tuned off the audio thread and handed back.
+                if let Some(plan) = assert_no_alloc(|| engine.take_wanted_tuning_plan()) {
+                    let voice = scratch.get_or_insert_with(|| plan.scratch_voice());
+                    for string in plan.strings().take(PLANNED_STRINGS_TUNED) {
+                        let tuned = plan.tune(voice, &string);
+                        assert_no_alloc(|| engine.remember_tuning(&tuned));
+                    }
                 }
                 rendered += length;
                 if rendered >= MAX_SAMPLES_PER_INPUT {
