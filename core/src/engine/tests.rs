@@ -535,8 +535,7 @@ fn the_first_drone_string_sounds_on_the_left_and_the_last_on_the_right() {
 }
 
 #[test]
-fn a_glide_retunes_one_ringing_string_every_other_control_tick_and_every_string_reaches_the_target()
-{
+fn a_glide_retunes_a_ringing_string_every_other_tick_and_each_reaches_the_target() {
     let mut settings = EngineSettings::default();
     settings.voice.quality = Quality::Draft;
     let mut engine = Engine::new(&settings, RATE, 4);
