@@ -1387,7 +1387,13 @@ impl Engine {
             if string_settings == *slot.voice.settings() {
                 continue;
             }
-            slot.voice.set_settings(&string_settings);
+            // A string whose tension is remembered for these settings (the tuning plan's, once
+            // the worker has handed it back: a glide's last retune) is configured at it instead
+            // of tuned (`tuning_memory.rs`).
+            match self.tunings.tension_n(&string_settings) {
+                Some(tension) => slot.voice.set_settings_tuned(&string_settings, tension),
+                None => slot.voice.set_settings(&string_settings),
+            }
             self.retune_cursor = (index + 1) % count;
             self.next_retune = self.clock + RETUNE_INTERVAL;
             return;

@@ -990,3 +990,56 @@ fn the_drones_strings_are_tuned_from_the_plan_off_the_audio_thread() {
     );
     assert_eq!(unplanned.string_tunings(), unplanned_made + 4);
 }
+
+/// A ringing string's last retune of a glide, once the tuning plan's tensions are back, takes
+/// its tension from the memory: after a move of the thread, four ringing strings tune four times
+/// fewer than on an engine that gets no tensions back, and end at the same settings.
+#[test]
+fn a_glides_last_retune_of_a_ringing_string_takes_the_plans_tension() {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Live;
+    let started = || {
+        let mut engine = Engine::new(&settings, RATE, 4);
+        engine.prepare_tunings();
+        let notes: Vec<TimedEvent> = [45u8, 50, 55, 60]
+            .iter()
+            .enumerate()
+            .map(|(index, &note)| note_on(index, note))
+            .collect();
+        run(&mut engine, &notes, 64);
+        engine
+    };
+    let (mut planned, mut unplanned) = (started(), started());
+    let mut moved = settings;
+    moved.voice.thread_position_m += 0.002;
+    planned.set_settings(&moved);
+    unplanned.set_settings(&moved);
+    let plan = planned
+        .take_wanted_tuning_plan()
+        .expect("a plan for the moved thread");
+    let mut voice = plan.scratch_voice();
+    for string in plan.strings() {
+        planned.remember_tuning(&plan.tune(&mut voice, &string));
+    }
+    let (planned_made, unplanned_made) = (planned.string_tunings(), unplanned.string_tunings());
+    let glide_and_round = (2.0 * SMOOTHING_TIME_S * RATE) as usize + 8 * RETUNE_INTERVAL as usize;
+    run(&mut planned, &[], glide_and_round);
+    run(&mut unplanned, &[], glide_and_round);
+    let retuned = |engine: &Engine| -> Vec<VoiceSettings> {
+        engine
+            .slots
+            .iter()
+            .map(|slot| *slot.voice.settings())
+            .collect()
+    };
+    assert_eq!(retuned(&planned), retuned(&unplanned));
+    assert!(retuned(&planned)
+        .iter()
+        .all(|string| (string.thread_position_m - moved.voice.thread_position_m).abs() < 1e-12));
+    let (planned_tunings, unplanned_tunings) = (
+        planned.string_tunings() - planned_made,
+        unplanned.string_tunings() - unplanned_made,
+    );
+    assert!(unplanned_tunings >= 4, "{unplanned_tunings}");
+    assert_eq!(planned_tunings + 4, unplanned_tunings);
+}

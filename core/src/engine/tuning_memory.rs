@@ -21,6 +21,9 @@
 //! mode the plan holds the drone's strings on its Sa first (each with its own fine tuning and
 //! thread, so most are no note's string): they are the ones ringing.
 //!
+//! A ringing string retuned to settings the memory holds (a glide's last retune, once the plan
+//! is back) is configured at the remembered tension too (`Engine::control_tick`).
+//!
 //! Entries are keyed by the whole settings, so a change of any setting the tuning sees (the
 //! thread, the bridge, the tier, the pitch) finds none and tunes the string as before, until a
 //! plan's tensions arrive; the oldest entry makes room for a new one. A fixed array searched in
