@@ -534,17 +534,22 @@ fn the_first_drone_string_sounds_on_the_left_and_the_last_on_the_right() {
     assert_eq!(drone_string_pan(1, 5), -0.5);
 }
 
-#[test]
-fn a_glide_retunes_a_ringing_string_every_other_tick_and_each_reaches_the_target() {
-    let mut settings = EngineSettings::default();
-    settings.voice.quality = Quality::Draft;
-    let mut engine = Engine::new(&settings, RATE, 4);
+/// Notes 45, 50, 55 and 60 plucked one sample apart, and the block of 64 samples they start in.
+fn pluck_four_notes(engine: &mut Engine) {
     let notes: Vec<TimedEvent> = [45u8, 50, 55, 60]
         .iter()
         .enumerate()
         .map(|(index, &note)| note_on(index, note))
         .collect();
-    run(&mut engine, &notes, 64);
+    run(engine, &notes, 64);
+}
+
+#[test]
+fn a_glide_retunes_a_ringing_string_every_other_tick_and_each_reaches_the_target() {
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Draft;
+    let mut engine = Engine::new(&settings, RATE, 4);
+    pluck_four_notes(&mut engine);
     assert_eq!(engine.active_voices(), 4);
     settings.voice.thread_position_m = 0.042;
     engine.set_settings(&settings);
@@ -1001,12 +1006,7 @@ fn a_glides_last_retune_of_a_ringing_string_takes_the_plans_tension() {
     let started = || {
         let mut engine = Engine::new(&settings, RATE, 4);
         engine.prepare_tunings();
-        let notes: Vec<TimedEvent> = [45u8, 50, 55, 60]
-            .iter()
-            .enumerate()
-            .map(|(index, &note)| note_on(index, note))
-            .collect();
-        run(&mut engine, &notes, 64);
+        pluck_four_notes(&mut engine);
         engine
     };
     let (mut planned, mut unplanned) = (started(), started());
