@@ -155,6 +155,25 @@ impl Default for DroneSettings {
     }
 }
 
+impl DroneSettings {
+    /// Each of the pattern's strings on a Sa of `sa_hz`, in playing order: its pitch, `Sa × its
+    /// ratio × its fine tuning`, and its thread's offset. The one place that pitch is formed, so
+    /// that a string planned or calibrated is the plucked one to the bit.
+    pub fn string_pitches(&self, sa_hz: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let (ratios, count) = string_ratios(self.first_string, self.pattern);
+        ratios
+            .into_iter()
+            .zip(&self.strings)
+            .take(count)
+            .map(move |(ratio, string)| {
+                (
+                    sa_hz * ratio * string.fine_tune_ratio(),
+                    string.thread_offset_m,
+                )
+            })
+    }
+}
+
 /// Frequency ratio of each drone string to Sa, in playing order; the count is the pattern's.
 pub fn string_ratios(
     first_string: FirstString,

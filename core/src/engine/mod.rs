@@ -939,13 +939,8 @@ impl Engine {
             let hz = settings.tuning.note_hz(note);
             if settings.drone.enabled {
                 let drone = settings.drone;
-                let (ratios, count) = string_ratios(drone.first_string, drone.pattern);
-                for (ratio, string) in ratios.iter().zip(&drone.strings).take(count) {
-                    add(
-                        hz * ratio * string.fine_tune_ratio(),
-                        string.thread_offset_m,
-                        drone_velocities(&drone),
-                    );
+                for (fundamental_hz, thread_offset_m) in drone.string_pitches(hz) {
+                    add(fundamental_hz, thread_offset_m, drone_velocities(&drone));
                 }
             } else {
                 add(hz, 0.0, NOTE_VELOCITIES);
@@ -1279,21 +1274,7 @@ impl Engine {
         else {
             return plan;
         };
-        let sa_hz = self.target.tuning.note_hz(sa_note);
-        let (ratios, count) = string_ratios(drone.first_string, drone.pattern);
-        plan.with_drone_strings(
-            ratios
-                .iter()
-                .zip(&drone.strings)
-                .take(count)
-                // The pitch as the drone's pluck forms it, to the bit.
-                .map(|(ratio, string)| {
-                    (
-                        sa_hz * ratio * string.fine_tune_ratio(),
-                        string.thread_offset_m,
-                    )
-                }),
-        )
+        plan.with_drone_strings(drone.string_pitches(self.target.tuning.note_hz(sa_note)))
     }
 
     /// The plan whose tensions the memory lacks, once after each change of what the tuning sees
@@ -1495,10 +1476,12 @@ impl Engine {
             return;
         };
         self.last_drone_sa = Some(sa_note);
-        let (ratios, _) = string_ratios(drone.first_string, drone.pattern);
-        let hz = self.target.tuning.note_hz(sa_note)
-            * ratios[pluck.string]
-            * drone.strings[pluck.string].fine_tune_ratio();
+        let Some((hz, _)) = drone
+            .string_pitches(self.target.tuning.note_hz(sa_note))
+            .nth(pluck.string)
+        else {
+            return;
+        };
         let (low, high) = VoiceSettings::FUNDAMENTAL_RANGE_HZ;
         if (low..=high).contains(&hz) {
             self.pluck_string(StringKey::Drone(pluck.string), hz, pluck.strength as f32);
