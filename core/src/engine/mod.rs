@@ -1242,7 +1242,8 @@ impl Engine {
     /// (`tuning_memory.rs`), with the settings the strings take once the smoothed controls have
     /// reached their targets: a note-on on one of them then configures its string once instead
     /// of tuning it. For the host to call off the audio thread when it activates the plugin;
-    /// allocates a scratch voice, and took 32–33 ms at the fine tier (80 notes) on a 2.6 GHz Xeon.
+    /// allocates a scratch voice, and took 19–21 ms at the fine tier (80 notes) on a 2.6 GHz
+    /// Xeon (stop 55).
     pub fn prepare_tunings(&mut self) {
         let plan = self.tuning_plan();
         let mut voice = plan.scratch_voice();
@@ -1337,9 +1338,9 @@ impl Engine {
         }
         // At most one ringing string takes the new settings every [`RETUNE_INTERVAL`] samples
         // (every other control tick), the next in turn whose settings differ: retuning a string
-        // (a new rest state and its linearised fundamental) costs about a ninth of a 64-sample
-        // block's deadline at the live tier (169 µs, studio 739 µs: `--example retune_cost`)
-        // and about a fifth at the fine tier (315 µs, `--example note_on_cost`), so retuning
+        // (a new rest state and its linearised fundamental) costs about a fourteenth of a
+        // 64-sample block's deadline at the live tier (102–104 µs: `--example retune_cost`)
+        // and about a seventh at the fine tier (218–221 µs; 290 µs before stop 55), so retuning
         // every string at every tick of a glide of k_b or the thread missed the deadline
         // several times over (the soak), and one at every tick still lifted the fine tier's
         // slowest blocks under automation by a third (`docs/performance.md`, stop 54). With

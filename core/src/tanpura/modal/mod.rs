@@ -103,8 +103,23 @@ struct ThreadLattice {
 const THREAD_EDGE_MARGIN: f64 = 0.35;
 /// Far points are put to sleep this often (the check costs a pass over the modes and points).
 const SLEEP_CHECK_STEPS: usize = 256;
-/// Inverse iterations for the linearised fundamental (the error falls by (f₁/f₂)² ≈ 1/4 each).
+/// Inverse iterations for the linearised fundamental at most (the eigenvector's error falls by
+/// (f₁/f₂)² ≈ 1/4 each, the Rayleigh quotient's by its square); the iteration stops sooner once
+/// the quotient has settled ([`rayleigh_settled`]).
 const TUNING_ITERATIONS: usize = 30;
+/// The relative change of the Rayleigh quotient ω² between two inverse iterations below which
+/// it has settled: falling about sixteenfold an iteration, its remaining error is then near
+/// 1e-14 of ω², a pitch error near 1e-11 cents. At the fine tier the quotient settles after 12
+/// iterations, where 30 fixed ones spent the rest on round-off (`docs/performance.md`, stop 55).
+const RAYLEIGH_SETTLED: f64 = 1e-13;
+
+/// Whether the Rayleigh quotient `current` of an inverse iteration has settled after `previous`:
+/// changed by at most `tolerance` of itself ([`RAYLEIGH_SETTLED`]; 0 runs every iteration unless
+/// two quotients are equal).
+#[inline]
+pub(super) fn rayleigh_settled(previous: f64, current: f64, tolerance: f64) -> bool {
+    (current - previous).abs() <= tolerance * current.abs()
+}
 /// Points whose gap lies within this distance of contact are tracked: Newton iterates on them.
 /// Every other point's step follows from the converged forces, and a point that would touch joins
 /// before the step is taken (`ModalString::step`), so the band is only a matter of cost: a point
@@ -1483,6 +1498,12 @@ impl<T: Real> ModalString<T> {
     /// The fundamental of small vibrations about the rest state with every point in contact at
     /// rest acting as a spring of its stiffness, Hz (section 5). Allocation-free.
     pub fn linearised_fundamental_hz(&mut self) -> f64 {
+        self.linearised_fundamental_settled_hz(RAYLEIGH_SETTLED)
+    }
+
+    /// [`ModalString::linearised_fundamental_hz`] with the inverse iteration stopped once its
+    /// Rayleigh quotient moves by at most `settled_below` of itself ([`rayleigh_settled`]).
+    fn linearised_fundamental_settled_hz(&mut self, settled_below: f64) -> f64 {
         let modes = self.modes.count();
         let angular = if self.nodal_in_use {
             // On the nodes (`nodal_statics.rs`), with the contact points alone loaded.
@@ -1494,6 +1515,7 @@ impl<T: Real> ModalString<T> {
                 &self.modes.angular_frequency,
                 modes,
                 TUNING_ITERATIONS,
+                settled_below,
             )
         } else {
             linearised_fundamental(
@@ -1502,6 +1524,7 @@ impl<T: Real> ModalString<T> {
                 modes,
                 &mut self.solver,
                 TUNING_ITERATIONS,
+                settled_below,
             )
         };
         angular / (2.0 * PI)
@@ -2062,6 +2085,35 @@ mod tests {
             );
             assert_eq!(nodes.static_solve_failures(), 0);
             assert_eq!(points.static_solve_failures(), 0);
+        }
+    }
+
+    /// The linearised fundamental's inverse iteration stops once its Rayleigh quotient has
+    /// settled, well before the cap, at the frequency every iteration reaches: on the nodes (the
+    /// fine tier's string) and on the points, at two tensions, within 1e-13 of the frequency
+    /// the full 30 iterations give.
+    #[test]
+    fn the_linearised_fundamental_stops_once_settled_at_the_converged_frequency() {
+        for tension_n in [52.0, 80.0] {
+            for condensed in [true, false] {
+                let mut config = grid_mode_config(0.36e-3, 0.2e-3, condensed);
+                config.string.tension_n = tension_n;
+                let mut string = ModalString::<f64>::new(config);
+                let settled = string.linearised_fundamental_hz();
+                let settled_iterations = string.statics.fundamental_iterations;
+                let every = string.linearised_fundamental_settled_hz(0.0);
+                assert!(
+                    (settled / every - 1.0).abs() <= 1e-13,
+                    "{tension_n} N, condensed {condensed}: {settled} Hz against {every} Hz"
+                );
+                if condensed {
+                    assert!(
+                        settled_iterations <= TUNING_ITERATIONS / 2,
+                        "{tension_n} N: {settled_iterations} iterations"
+                    );
+                    assert!(string.statics.fundamental_iterations > settled_iterations);
+                }
+            }
         }
     }
 

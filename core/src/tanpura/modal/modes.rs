@@ -91,7 +91,15 @@ pub struct ModeSet {
     pub loss_factor: Vec<f64>,
     /// c_k: the nut force of eq. 13 per unit r_k, N per √J.
     pub nut_weight: Vec<f64>,
+    /// With grid modes of N intervals, `sin(π m/N)` for m in `0..2N` ([`ModeSet::grid_sines`]),
+    /// and the N they were formed for (0: none yet).
+    grid_sines: Vec<f64>,
+    grid_sines_intervals: usize,
 }
+
+/// Room in [`ModeSet`]'s table of the grid's sines: 2N entries for the largest grid
+/// ([`GridModes::is_valid`]: N ≤ MODE_CAPACITY + 1).
+const GRID_SINE_CAPACITY: usize = 2 * (MODE_CAPACITY + 1);
 
 impl ModeSet {
     /// Room for [`MODE_CAPACITY`] modes. Allocates.
@@ -113,7 +121,30 @@ impl ModeSet {
             kinetic_factor: zeros(),
             loss_factor: zeros(),
             nut_weight: zeros(),
+            grid_sines: vec![0.0; GRID_SINE_CAPACITY],
+            grid_sines_intervals: 0,
         }
+    }
+
+    /// `sin(π m/N)` for m in `0..2N` on the grid of N intervals these modes were configured on,
+    /// the table [`ModeSet::configure`] forms once per grid; `None` without grid modes or for
+    /// another N. The sampled sine of mode k at node n is entry `k n mod 2N`: the `sin` of its
+    /// reduced argument instead of the end of a recurrence over k.
+    #[inline]
+    pub fn grid_sines(&self, intervals: usize) -> Option<&[f64]> {
+        (intervals > 0 && intervals == self.grid_sines_intervals)
+            .then(|| &self.grid_sines[..2 * intervals])
+    }
+
+    /// Forms the table of [`ModeSet::grid_sines`] for N intervals if it is not that grid's.
+    fn form_grid_sines(&mut self, intervals: usize) {
+        if intervals == self.grid_sines_intervals || 2 * intervals > GRID_SINE_CAPACITY {
+            return;
+        }
+        for (m, sine) in self.grid_sines[..2 * intervals].iter_mut().enumerate() {
+            *sine = (PI * m as f64 / intervals as f64).sin();
+        }
+        self.grid_sines_intervals = intervals;
     }
 
     /// Every mode the step advances (the kept modes and the residual modes).
@@ -179,6 +210,9 @@ impl ModeSet {
         let half_length = 0.5 * length;
         let mass = string.linear_density_kg_m * half_length;
         let grid = grid.filter(|grid| grid.is_valid());
+        if let Some(GridModes { intervals, .. }) = grid {
+            self.form_grid_sines(intervals);
+        }
         self.length_m = length;
         self.tension_n = string.tension_n;
         self.bending_stiffness_n_m2 = string.bending_stiffness_n_m2;
@@ -198,7 +232,10 @@ impl ModeSet {
                     let k2 = (2.0 * half_angle.sin() / spacing).powi(2);
                     // The FD operator's nut force (`fd::operator::StringOperator::nut_force_n`)
                     // of the sampled sine, whose nodes N − 1 and N − 2 are these.
-                    let node = |i: usize| (number * PI * i as f64 / intervals as f64).sin();
+                    let node = |i: usize| match self.grid_sines(intervals) {
+                        Some(sines) => sines[(index + 1) * i % (2 * intervals)],
+                        None => (number * PI * i as f64 / intervals as f64).sin(),
+                    };
                     let last = node(intervals - 1);
                     let curvature = (node(intervals - 2) - 2.0 * last) / (spacing * spacing);
                     let nut_force = -string.bending_stiffness_n_m2 * curvature / spacing

@@ -287,10 +287,34 @@ fn law_lane(gap: f64, step: f64, xi: f64, psi: f64) -> (f64, f64, f64) {
 }
 
 /// Node `node`'s row of V into `row` (MODE_CAPACITY long): `V_k = sin(kπ n/N)/√κ_k` over the
-/// modes, zeros beyond them, the sines by the recurrence `sin((k+1)θ) = 2 cos θ sin(kθ) −
-/// sin((k−1)θ)`. The condensed step's and the static problems' node rows are the same.
+/// modes, zeros beyond them. The sines come from the modes' table of the grid's sines
+/// ([`ModeSet::grid_sines`], entry k n mod 2N), else by the recurrence `sin((k+1)θ) = 2 cos θ
+/// sin(kθ) − sin((k−1)θ)`, a chain of dependent multiply-subtracts that took a seventh of a
+/// retune at the fine tier (`docs/performance.md`, stop 55). The condensed step's and the static
+/// problems' node rows are the same.
 pub(super) fn write_node_row(node: usize, intervals: usize, modes: &ModeSet, row: &mut [f64]) {
     row.fill(0.0);
+    if let Some(sines) = modes.grid_sines(intervals) {
+        // k n mod 2N, stepped by n < N.
+        let node = node % intervals;
+        let mut index = 0;
+        for (value, scale) in row[..modes.count()]
+            .iter_mut()
+            .zip(&modes.inverse_root_stiffness)
+        {
+            index += node;
+            if index >= sines.len() {
+                index -= sines.len();
+            }
+            *value = sines[index] * scale;
+        }
+    } else {
+        write_node_row_by_recurrence(node, intervals, modes, row);
+    }
+}
+
+/// [`write_node_row`] by the sines' recurrence (modes without the grid's table).
+fn write_node_row_by_recurrence(node: usize, intervals: usize, modes: &ModeSet, row: &mut [f64]) {
     let theta = PI * node as f64 / intervals as f64;
     let twice_cos = 2.0 * theta.cos();
     let (mut previous, mut current) = (0.0, theta.sin());
@@ -1346,6 +1370,40 @@ impl NodalContact {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The node rows read from the grid's sines are the recurrence's, to round-off, at every
+    /// node of the reference's grid (N = 200, the fine tier's) and of an odd one; a row read at
+    /// another index than `k n mod 2N` fails.
+    #[test]
+    fn node_rows_from_the_grid_sines_are_the_recurrences() {
+        for intervals in [200, 37] {
+            let mut config = super::super::tests::grid_mode_config(0.36e-3, 0.2e-3, true);
+            if let Some(grid) = &mut config.grid_modes {
+                grid.intervals = intervals;
+            }
+            let string = super::super::ModalString::<f64>::new(config);
+            let modes = &string.modes;
+            assert!(modes.grid_sines(intervals).is_some());
+            assert!(modes.count() > intervals / 2);
+            // A sine times its mode's 1/√κ is at most the largest of those.
+            let largest = modes
+                .inverse_root_stiffness
+                .iter()
+                .fold(0.0f64, |m, v| m.max(*v));
+            let (mut table, mut recurrence) = (vec![0.0; MODE_CAPACITY], vec![0.0; MODE_CAPACITY]);
+            for node in 0..=intervals {
+                write_node_row(node, intervals, modes, &mut table);
+                write_node_row_by_recurrence(node, intervals, modes, &mut recurrence);
+                for (k, (a, b)) in table.iter().zip(&recurrence).enumerate() {
+                    assert!(
+                        (a - b).abs() <= 1e-12 * largest,
+                        "N = {intervals}, node {node}, mode {}: {a:e} against {b:e}",
+                        k + 1
+                    );
+                }
+            }
+        }
+    }
 
     /// The branch-free law is `contact.rs`'s mid-point force with the linearly implicit damping
     /// in each of its four cases (staying in, leaving, entering, staying out), force and

@@ -61,6 +61,8 @@ pub enum NodalStaticsError {
 /// [`NodalStatics::new`].
 #[derive(Debug, Clone)]
 pub struct NodalStatics {
+    /// The inverse iterations the last linearised fundamental took.
+    pub(super) fundamental_iterations: usize,
     intervals: usize,
     length_m: f64,
     /// The grid nodes (1 … N − 1) the loaded points reach, in the order they were met, and each
@@ -116,6 +118,7 @@ impl NodalStatics {
         let zeros = |n: usize| vec![0.0; n];
         let nodes = STATIC_NODE_CAPACITY;
         Self {
+            fundamental_iterations: 0,
             intervals: 0,
             length_m: 0.0,
             node_count: 0,
@@ -499,7 +502,9 @@ impl NodalStatics {
     }
 
     /// The lowest eigenfrequency of the modes with a spring `k_i` at every loaded point whose
-    /// force `rest_forces_n[i]` is positive, rad/s, by `iterations` steps of inverse iteration
+    /// force `rest_forces_n[i]` is positive, rad/s, by at most `iterations` steps of inverse
+    /// iteration, fewer once the Rayleigh quotient has settled within `settled_below` of itself
+    /// (`super::rayleigh_settled`)
     /// (after [`Self::prepare`] on the same points). NaN when `K + C` is not positive definite.
     pub fn linearised_fundamental(
         &mut self,
@@ -507,6 +512,7 @@ impl NodalStatics {
         omega: &[f64],
         modes: usize,
         iterations: usize,
+        settled_below: f64,
     ) -> f64 {
         let n = self.node_count;
         let lanes = padded_lanes(modes);
@@ -564,7 +570,9 @@ impl NodalStatics {
         }
         let mut rayleigh = 0.0;
         let (mut squared, mut mass) = ([0.0], [0.0]);
+        self.fundamental_iterations = 0;
         for _ in 0..iterations {
+            self.fundamental_iterations += 1;
             // x ← v − Vᵀ [C − C (K + C)⁻¹ C] V v.
             project_and_spring(&product[..lanes], &mut self.column, &mut self.scratch);
             self.column[..n].copy_from_slice(&self.scratch[..n]);
@@ -601,7 +609,10 @@ impl NodalStatics {
                 + (0..n)
                     .map(|j| self.column[j] * self.scratch[j])
                     .sum::<f64>();
-            rayleigh = stiffness / mass[0];
+            let previous = std::mem::replace(&mut rayleigh, stiffness / mass[0]);
+            if super::rayleigh_settled(previous, rayleigh, settled_below) {
+                break;
+            }
             let inverse_norm = 1.0 / squared[0].sqrt();
             for (value, scaled) in x[..lanes].iter_mut().zip(product[..lanes].iter_mut()) {
                 *value *= inverse_norm;

@@ -426,7 +426,8 @@ impl StaticSolver {
 }
 
 /// The lowest eigenfrequency of the modes with a spring `w_i k` at every point in contact at
-/// rest, rad/s, by inverse iteration (`iterations` solves). `omega` are the modes' angular
+/// rest, rad/s, by inverse iteration (at most `iterations` solves, fewer once the Rayleigh
+/// quotient has settled within `settled_below` of itself: `super::rayleigh_settled`). `omega` are the modes' angular
 /// frequencies. Allocation-free: it works in the static solver's buffers.
 pub fn linearised_fundamental(
     points: &ContactPoints,
@@ -434,6 +435,7 @@ pub fn linearised_fundamental(
     modes: usize,
     solver: &mut StaticSolver,
     iterations: usize,
+    settled_below: f64,
 ) -> f64 {
     let lanes = padded_lanes(modes);
     let kernels = solver.kernels;
@@ -521,7 +523,10 @@ pub fn linearised_fundamental(
         let mass: f64 = (0..modes)
             .map(|k| x[k] * x[k] / (omega[k] * omega[k]))
             .sum();
-        rayleigh = stiffness / mass;
+        let previous = std::mem::replace(&mut rayleigh, stiffness / mass);
+        if super::rayleigh_settled(previous, rayleigh, settled_below) {
+            break;
+        }
         let norm = norms[0].sqrt();
         for value in &mut x[..modes] {
             *value /= norm;
