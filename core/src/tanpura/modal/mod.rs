@@ -120,6 +120,7 @@ const RAYLEIGH_SETTLED: f64 = 1e-13;
 pub(super) fn rayleigh_settled(previous: f64, current: f64, tolerance: f64) -> bool {
     (current - previous).abs() <= tolerance * current.abs()
 }
+
 /// Points whose gap lies within this distance of contact are tracked: Newton iterates on them.
 /// Every other point's step follows from the converged forces, and a point that would touch joins
 /// before the step is taken (`ModalString::step`), so the band is only a matter of cost: a point
