@@ -127,8 +127,8 @@ fn tier_latency(slots: &[Slot], settings: &EngineSettings) -> usize {
 /// Samples between two updates of the strings' smoothed settings.
 pub const CONTROL_INTERVAL: u64 = 32;
 /// Samples at least between two retunes of ringing strings to the smoothed settings (every other
-/// control tick): a retune at the fine tier costs about a fifth of a 64-sample block's deadline,
-/// so that a glide's retunes add at most one to each block (`Engine::control_tick`).
+/// control tick): a retune at the fine tier costs about a seventh of a 64-sample block's
+/// deadline, so that a glide's retunes add at most one to each block (`Engine::control_tick`).
 pub const RETUNE_INTERVAL: u64 = 2 * CONTROL_INTERVAL;
 /// Time a continuous setting takes to reach a new value, s.
 pub const SMOOTHING_TIME_S: f64 = 0.02;
@@ -1283,8 +1283,8 @@ impl Engine {
     /// Sa or its strings), for a worker to tune off the audio thread and hand back through
     /// [`Engine::remember_tuning`]; `None` while nothing changed since the last plan prepared or
     /// handed out, and while the bowed string plays. Without it each string's first pluck after
-    /// such a change tunes it on the audio thread: 345–357 µs at the fine tier against
-    /// 92–98 µs to configure it (`tuning_memory.rs`). Allocation-free.
+    /// such a change tunes it on the audio thread: 235–237 µs at the fine tier against
+    /// 67–68 µs to configure it (`tuning_memory.rs`). Allocation-free.
     pub fn take_wanted_tuning_plan(&mut self) -> Option<TuningPlan> {
         if self.target.instrument != Instrument::Tanpura {
             return None;

@@ -7,7 +7,7 @@
 //! bridge and thread) and an inverse iteration for its linearised fundamental, then configured
 //! a third time. At the fine tier that took 345–357 µs of a note-on's 0.48 ms on a 2.6 GHz
 //! AVX-512 Xeon, a quarter of a 64-sample block's deadline, on top of the block's other strings
-//! (`docs/performance.md`, "Stop 51"). The tension it reaches is a function of the settings
+//! (`docs/performance.md`, "Stop 51"); 235–237 µs since stop 55 (`--example note_on_cost`). The tension it reaches is a function of the settings
 //! alone (the losses and the pickup mix aside, which the tuning does not see), so the engine
 //! remembers it: the next note-on with the same settings configures the string once at that
 //! tension ([`crate::tanpura::TanpuraVoice::set_settings_tuned`]).
@@ -28,8 +28,8 @@
 //! thread, the bridge, the tier, the pitch) finds none and tunes the string as before, until a
 //! plan's tensions arrive; the oldest entry makes room for a new one. A fixed array searched in
 //! order: at most [`TUNING_MEMORY_CAPACITY`] comparisons of a few numbers each, against the
-//! 250 µs a hit saves at the fine tier (configured once in 92–98 µs, tuned in 345–357 µs,
-//! `docs/performance.md`), and nothing allocates after [`TuningMemory::new`].
+//! 170 µs a hit saves at the fine tier (configured once in 67–68 µs, tuned in 235–237 µs,
+//! `--example note_on_cost`, stop 55), and nothing allocates after [`TuningMemory::new`].
 
 use crate::engine::drone::MAX_DRONE_STRINGS;
 use crate::engine::pitch::Tuning;
@@ -215,7 +215,7 @@ impl TuningPlan {
         TanpuraVoice::new(&self.base, self.sample_rate_hz)
     }
 
-    /// Tunes `settings`' string on `voice` (a fine string: 345–357 µs on a 2.6 GHz Xeon).
+    /// Tunes `settings`' string on `voice` (a fine string: 235–237 µs on a 2.6 GHz Xeon).
     pub fn tune(&self, voice: &mut TanpuraVoice, settings: &VoiceSettings) -> PlannedTension {
         voice.set_settings(settings);
         PlannedTension {

@@ -532,8 +532,8 @@ impl TanpuraVoice {
     /// known: `tension_n` is [`TanpuraVoice::tension_n`] of a voice set to the same settings
     /// (their losses and pickup mix aside, which the tuning does not see). A retune then
     /// configures the string once at that tension, where [`TanpuraVoice::set_settings`] tunes it
-    /// (three configurations and two linearised fundamentals; at the fine tier 345–357 µs of a
-    /// note-on's 0.48 ms, `docs/performance.md`). Allocation-free.
+    /// (three configurations and two linearised fundamentals; at the fine tier 235–237 µs against
+    /// 67–68 µs, `--example note_on_cost`). Allocation-free.
     pub fn set_settings_tuned(&mut self, settings: &VoiceSettings, tension_n: f64) {
         self.apply_settings(settings, Some(tension_n));
     }

@@ -136,9 +136,10 @@ impl ModeSet {
             .then(|| &self.grid_sines[..2 * intervals])
     }
 
-    /// Forms the table of [`ModeSet::grid_sines`] for N intervals if it is not that grid's.
+    /// Forms the table of [`ModeSet::grid_sines`] for N intervals (a valid grid's: 2N fits) if
+    /// it is not that grid's.
     fn form_grid_sines(&mut self, intervals: usize) {
-        if intervals == self.grid_sines_intervals || 2 * intervals > GRID_SINE_CAPACITY {
+        if intervals == self.grid_sines_intervals {
             return;
         }
         for (m, sine) in self.grid_sines[..2 * intervals].iter_mut().enumerate() {
@@ -232,10 +233,8 @@ impl ModeSet {
                     let k2 = (2.0 * half_angle.sin() / spacing).powi(2);
                     // The FD operator's nut force (`fd::operator::StringOperator::nut_force_n`)
                     // of the sampled sine, whose nodes N − 1 and N − 2 are these.
-                    let node = |i: usize| match self.grid_sines(intervals) {
-                        Some(sines) => sines[(index + 1) * i % (2 * intervals)],
-                        None => (number * PI * i as f64 / intervals as f64).sin(),
-                    };
+                    // The table is this grid's (formed above).
+                    let node = |i: usize| self.grid_sines[(index + 1) * i % (2 * intervals)];
                     let last = node(intervals - 1);
                     let curvature = (node(intervals - 2) - 2.0 * last) / (spacing * spacing);
                     let nut_force = -string.bending_stiffness_n_m2 * curvature / spacing

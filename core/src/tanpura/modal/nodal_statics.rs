@@ -504,8 +504,8 @@ impl NodalStatics {
     /// The lowest eigenfrequency of the modes with a spring `k_i` at every loaded point whose
     /// force `rest_forces_n[i]` is positive, rad/s, by at most `iterations` steps of inverse
     /// iteration, fewer once the Rayleigh quotient has settled within `settled_below` of itself
-    /// (`super::rayleigh_settled`)
-    /// (after [`Self::prepare`] on the same points). NaN when `K + C` is not positive definite.
+    /// (`super::rayleigh_settled`), after [`Self::prepare`] on the same points. NaN when `K + C`
+    /// is not positive definite.
     pub fn linearised_fundamental(
         &mut self,
         rest_forces_n: &[f64],

@@ -427,8 +427,8 @@ impl StaticSolver {
 
 /// The lowest eigenfrequency of the modes with a spring `w_i k` at every point in contact at
 /// rest, rad/s, by inverse iteration (at most `iterations` solves, fewer once the Rayleigh
-/// quotient has settled within `settled_below` of itself: `super::rayleigh_settled`). `omega` are the modes' angular
-/// frequencies. Allocation-free: it works in the static solver's buffers.
+/// quotient has settled within `settled_below` of itself: `super::rayleigh_settled`). `omega`
+/// are the modes' angular frequencies. Allocation-free: it works in the static solver's buffers.
 pub fn linearised_fundamental(
     points: &ContactPoints,
     omega: &[f64],
