@@ -1,5 +1,5 @@
-//! Cost of the tanpura: one string at the modal live tier and at the FD reference tier, the
-//! four-string instrument, and the reference FD string's two Newton solvers (divan).
+//! Cost of the tanpura: one string at the modal live and fine tiers and at the FD reference
+//! tier, the four-string instrument, and the reference FD string's two Newton solvers (divan).
 //!
 //! `cargo bench -p javari-core --bench tanpura` (one group: `-- one_string`, `-- four_strings`,
 //! `-- fd_string`, `-- free_steps`).
@@ -17,11 +17,12 @@
 //! and are not timed.
 //!
 //! - `one_string`: a [`TanpuraVoice`] at the seed's reference string and settings
-//!   ([`VoiceSettings::default`]) on the modal live tier (the plugin default) and on the FD
-//!   reference tier (4 × oversampled, Δx = 3.34 mm, Newton to 1e-13 m through the condensed
-//!   solver, with its decimator), rendered by `TanpuraVoice::process`.
+//!   ([`VoiceSettings::default`]) on the modal live tier (the fastest that plays the jawari),
+//!   the modal fine tier (the plugin's default: the reference's grid in modes, contact on the
+//!   grid's nodes) and the FD reference tier (4 × oversampled, Δx = 3.34 mm, Newton to 1e-13 m
+//!   through the condensed solver, with its decimator), rendered by `TanpuraVoice::process`.
 //! - `four_strings`: the [`Tanpura`] drone (Pa, Sa, Sa, low Sa on the same settings), all four
-//!   strings plucked together, one `Tanpura::next_sample` per output sample, at both tiers.
+//!   strings plucked together, one `Tanpura::next_sample` per output sample, at the three tiers.
 //! - `fd_string`: the reference [`FdString`] stepped alone (no voice, no decimator) with the
 //!   condensed solver and with the plain full Newton.
 //! - `free_steps`: one call of the live tier's free-step kernel, its matrix on a cache line and
@@ -48,8 +49,8 @@ const BLOCK_S: f64 = 0.1;
 /// Output samples per benchmark iteration: 0.1 s at 44.1 kHz.
 const BLOCK_SAMPLES: usize = 4410;
 
-/// The tiers compared: the plugin's default and the renderer's.
-const TIERS: [Quality; 2] = [Quality::Live, Quality::Reference];
+/// The tiers compared: the fastest modal tier, the plugin's default and the renderer's.
+const TIERS: [Quality; 3] = [Quality::Live, Quality::Fine, Quality::Reference];
 
 fn main() {
     divan::main();
