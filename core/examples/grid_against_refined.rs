@@ -15,7 +15,9 @@
 //! grid instead of the continuous string's (§10); `-- --grid-spacings` the grid modes with the
 //! contact condensed on the nodes (§11) and contact points from the reference's spacing to the
 //! tier's; `-- --bands KEY VELOCITY POSITION_M` which 1/6-octave bands part the fine tier, the
-//! studio tier, the reference and the refined string at one pluck. `cargo xtask bench` measures
+//! studio tier, the reference and the refined string at one pluck; `-- --fine-rates` the fine
+//! tier's string at the output rate and at twice it over the whole grid against the reference
+//! (tuned by linearisation; no refined renders). `cargo xtask bench` measures
 //! the same without the residual modes, and caches the refined renders.
 //!
 //! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
@@ -186,6 +188,69 @@ fn grid_spacings_grid() {
         )
     });
     variants_over_grid(&variants);
+}
+
+/// `--fine-rates`: the fine tier's string as it runs (contact every output sample) and stepped at
+/// twice the output rate (decimated as the FD tiers are; its grid modes keep the reference's
+/// poles), over the whole grid against the reference, every scheme tuned by linearisation: what
+/// the contact's time step costs issue 15's band levels, and what halving it costs in time.
+fn fine_rates_grid() {
+    let points = full_grid();
+    let rates = [1usize, 2];
+    let results = measure_all(&points, |point| {
+        let reference = grid_render_linearised(Quality::Reference, point, SAMPLE_RATE_HZ, 0);
+        let (settings, pluck) = grid_pluck(Quality::Fine, point);
+        let nominal = point.nominal_hz();
+        rates.map(|oversample| {
+            let variant = ModalVariant {
+                oversample,
+                grid_modes: true,
+                ..ModalVariant::default()
+            };
+            let started = std::time::Instant::now();
+            let output = modal_variant_pluck(
+                &settings,
+                &variant,
+                &pluck,
+                javari_core::analysis::playing_range::NOTE_SECONDS,
+                SAMPLE_RATE_HZ,
+            )
+            .expect("the fine tier is modal");
+            let seconds = started.elapsed().as_secs_f64();
+            (
+                compare(&output, &reference, SAMPLE_RATE_HZ, nominal),
+                seconds,
+            )
+        })
+    });
+    println!(
+        "The fine tier's string over {} plucks against the reference, tuned by linearisation, \
+         worst / median (pitch cents, band levels dB, centroid %); render seconds in all:",
+        points.len()
+    );
+    for (column, oversample) in rates.iter().enumerate() {
+        let differences: Vec<&ListeningDifference> =
+            results.iter().map(|row| &row[column].0).collect();
+        let seconds: f64 = results.iter().map(|row| row[column].1).sum();
+        let figures = summary(&differences)
+            .map(|(worst, median)| format!("{worst:5.2} / {median:4.2}"))
+            .join(", ");
+        let worst_bands = points
+            .iter()
+            .zip(&results)
+            .max_by(|a, b| {
+                a.1[column]
+                    .0
+                    .band_level_db
+                    .total_cmp(&b.1[column].0.band_level_db)
+            })
+            .map(|(point, _)| point.label())
+            .unwrap_or_default();
+        println!(
+            "at {oversample}x the output rate: {figures} | band levels worst at {worst_bands} | \
+             {seconds:.1} s"
+        );
+    }
 }
 
 /// Each variant of the live tier's string over the whole grid, against N = 800 at 16× and
@@ -554,6 +619,10 @@ fn main() {
     }
     if args.iter().any(|arg| arg == "--grid-modes") {
         grid_modes_grid();
+        return;
+    }
+    if args.iter().any(|arg| arg == "--fine-rates") {
+        fine_rates_grid();
         return;
     }
     if args.iter().any(|arg| arg == "--rate-grid") {
