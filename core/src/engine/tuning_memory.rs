@@ -7,10 +7,11 @@
 //! bridge and thread) and an inverse iteration for its linearised fundamental, then configured
 //! a third time. At the fine tier that took 345–357 µs of a note-on's 0.48 ms on a 2.6 GHz
 //! AVX-512 Xeon, a quarter of a 64-sample block's deadline, on top of the block's other strings
-//! (`docs/performance.md`, "Stop 51"); 235–237 µs since stop 55 (`--example note_on_cost`). The tension it reaches is a function of the settings
-//! alone (the losses and the pickup mix aside, which the tuning does not see), so the engine
-//! remembers it: the next note-on with the same settings configures the string once at that
-//! tension ([`crate::tanpura::TanpuraVoice::set_settings_tuned`]).
+//! (`docs/performance.md`, "Stop 51"); 235–237 µs since stop 55 (`--example note_on_cost`).
+//! The tension it reaches is a function of the settings alone (the losses and the pickup mix
+//! aside, which the tuning does not see), so the engine remembers it: the next note-on with the
+//! same settings configures the string once at that tension
+//! ([`crate::tanpura::TanpuraVoice::set_settings_tuned`]).
 //!
 //! The memory fills as strings are tuned on note-ons, and [`crate::engine::Engine::prepare_tunings`]
 //! fills it off the audio thread for every note the tuning can play, as a host does when it
