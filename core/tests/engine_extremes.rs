@@ -290,12 +290,13 @@ fn non_finite_and_out_of_range_values_are_clamped() {
     }
 }
 
-/// The latency a host is told follows the tier: the FD tiers' decimator delay (whole samples)
-/// at studio and reference, none at the modal tiers and for the bowed string. An engine reports
-/// the latency it was built with until it adopts the tier's (the plugin does at activation), and
-/// a voice with less latency of its own is delayed to it: a modal string plucked while an FD
-/// latency is reported is exactly silent for that many samples and sounds from the next, and
-/// sounds from its first sample once the engine has adopted the modal tier's latency.
+/// The latency a host is told follows the tier: the decimator's delay (whole samples) at the
+/// oversampled tiers, studio and reference, none at the tiers at the output rate and for the
+/// bowed string. An engine reports the latency it was built with until it adopts the tier's (the
+/// plugin does at activation), and a voice with less latency of its own is delayed to it: a
+/// string at the output rate plucked while an oversampled tier's latency is reported is exactly
+/// silent for that many samples and sounds from the next, and sounds from its first sample once
+/// the engine has adopted its own tier's latency.
 #[test]
 fn latency_follows_the_tier_and_lower_latency_voices_are_delayed_to_it() {
     let tanpura = settings(Instrument::Tanpura);
@@ -305,14 +306,19 @@ fn latency_follows_the_tier_and_lower_latency_voices_are_delayed_to_it() {
         settings.instrument = instrument;
         settings
     };
-    let fd_latency =
+    let oversampled_latency =
         Engine::new(&at(Quality::Reference, Instrument::Tanpura), 44_100.0, 1).latency_samples();
-    println!("latency: {fd_latency} samples at the FD tiers");
-    assert!(fd_latency > 1.0 && fd_latency < 64.0, "{fd_latency}");
-    assert_eq!(fd_latency.fract(), 0.0);
+    println!(
+        "latency: {oversampled_latency} samples at the oversampled tiers (studio 2x, reference 4x)"
+    );
+    assert!(
+        oversampled_latency > 1.0 && oversampled_latency < 64.0,
+        "{oversampled_latency}"
+    );
+    assert_eq!(oversampled_latency.fract(), 0.0);
     for quality in Quality::ALL {
         let expected = if quality.oversample() > 1 {
-            fd_latency
+            oversampled_latency
         } else {
             0.0
         };
@@ -325,15 +331,15 @@ fn latency_follows_the_tier_and_lower_latency_voices_are_delayed_to_it() {
     // A change of tier is reported only once adopted.
     let mut engine = Engine::new(&at(Quality::Reference, Instrument::Tanpura), 44_100.0, 1);
     engine.set_settings(&at(Quality::Live, Instrument::Tanpura));
-    assert_eq!(engine.latency_samples(), fd_latency);
+    assert_eq!(engine.latency_samples(), oversampled_latency);
     assert_eq!(engine.tier_latency_samples(), 0.0);
-    let delay = fd_latency as usize;
+    let delay = oversampled_latency as usize;
     let pluck = [TimedEvent::note_on(0, 57, 1.0)];
     let mut output = vec![0.0f32; 256];
     engine.process(&pluck, &mut output);
     assert!(
         output[..delay].iter().all(|&x| x == 0.0),
-        "delayed to the FD latency"
+        "delayed to the oversampled tiers' latency"
     );
     assert!(output[delay] != 0.0, "silent after the delay");
     engine.adopt_tier_latency();
@@ -345,7 +351,7 @@ fn latency_follows_the_tier_and_lower_latency_voices_are_delayed_to_it() {
         "a modal string at the modal latency sounds at once"
     );
     engine.set_settings(&at(Quality::Studio, Instrument::Tanpura));
-    assert_eq!(engine.tier_latency_samples(), fd_latency);
+    assert_eq!(engine.tier_latency_samples(), oversampled_latency);
     engine.adopt_tier_latency();
-    assert_eq!(engine.latency_samples(), fd_latency);
+    assert_eq!(engine.latency_samples(), oversampled_latency);
 }

@@ -421,36 +421,47 @@ fn a_string_with_raised_stiffness_keeps_the_energy_balance() {
     assert!(worst_balance <= 1e-10, "balance error {worst_balance:e}");
 }
 
-/// The studio tier raises EI for its vibration only: at every key its string rests exactly
-/// where the reference tier's rests (the crest contact that decides how keys 48–54 sound).
+/// The studio tier is the fine tier's string stepped at twice the rate: at every key the two,
+/// tuned by their voices, take the same tension and rest in the same place at every contact
+/// point (the rest state and the tuning are statics, which the time step does not enter), so
+/// the studio's string rests where the fine's does, and with it where the reference's does
+/// (`tanpura_grid_modes.rs`).
 #[test]
-fn the_studio_tier_rests_where_the_reference_rests() {
+fn the_studio_tier_rests_where_the_fine_tier_rests() {
     use javari_core::engine::pitch::note_to_hz;
     use javari_core::tanpura::quality::Quality;
-    use javari_core::tanpura::voice::VoiceSettings;
+    use javari_core::tanpura::voice::{TanpuraVoice, VoiceSettings};
     for key in [36u8, 48, 51, 54, 64] {
-        let settings = VoiceSettings {
-            fundamental_hz: note_to_hz(key),
-            ..VoiceSettings::default()
+        let voice = |quality| {
+            let settings = VoiceSettings {
+                fundamental_hz: note_to_hz(key),
+                quality,
+                ..VoiceSettings::default()
+            };
+            TanpuraVoice::new(&settings, 44_100.0)
         };
-        let string = |quality| {
-            FdString::new(
-                settings
-                    .fd_config_at(quality, 44_100.0)
-                    .expect("an FD tier"),
-            )
-        };
-        let (studio, reference) = (string(Quality::Studio), string(Quality::Reference));
-        assert!(
-            studio.config().string.bending_stiffness_n_m2
-                > reference.config().string.bending_stiffness_n_m2,
-            "key {key}: the studio's EI is raised"
+        let (studio, fine) = (voice(Quality::Studio), voice(Quality::Fine));
+        let (studio, fine) = (
+            studio
+                .string()
+                .as_modal()
+                .expect("the studio tier is modal"),
+            fine.string().as_modal().expect("the fine tier is modal"),
         );
+        assert_eq!(studio.config().time_step_s, 0.5 * fine.config().time_step_s);
         assert_eq!(
-            studio.rest_displacement_m(),
-            reference.rest_displacement_m(),
+            studio.config().string.tension_n,
+            fine.config().string.tension_n,
             "key {key}"
         );
+        assert_eq!(studio.point_positions_m(), fine.point_positions_m());
+        for &x in fine.point_positions_m() {
+            assert_eq!(
+                studio.rest_displacement_at_m(x),
+                fine.rest_displacement_at_m(x),
+                "key {key}, x = {x} m"
+            );
+        }
     }
 }
 

@@ -110,14 +110,12 @@ fn the_fine_tier_sounds_like_the_reference_at_the_crest_keys_and_away() {
     }
 }
 
-/// At the crest keys the studio tier shares the reference's rest state (its raised EI acts on
-/// the vibration only, `tanpura/fd/mod.rs`, "Rest preload"), so with the linearised tuning of
-/// both, plucks that lift the string off the crest or leave it there do so alike: at keys 49 and
-/// 50, where every pluck from velocity 40 up lifts the reference's string off the crest,
-/// measured within 0.80 cents and 2.7 dB. Before stop 34 the studio's raised EI also moved its
-/// rest state, and key 49 at velocity 40 sounded 15.1 cents from the reference. (At a key where
-/// the string is bistable, such as 53, the hardest pluck can still lift one tier's string off
-/// the crest and not the other's: the calibration as played sets those strings' jawari.)
+/// At the crest keys the studio tier shares the reference's rest state (the fine tier's string
+/// on the reference's grid and points, `tanpura/modal/nodal_statics.rs`), so with the
+/// linearised tuning of both, plucks that lift the string off the crest or leave it there do so
+/// alike at keys 49 and 50, where every pluck from velocity 40 up lifts the reference's string
+/// off the crest. (The FD studio of stops 34–56 held this too, after its raised EI was kept off
+/// its rest state; before stop 34 key 49 at velocity 40 sounded 15.1 cents from the reference.)
 #[test]
 fn the_studio_tier_sounds_like_the_reference_at_the_crest_keys() {
     for (point, difference, _) in against_the_reference(Quality::Studio, &[49, 50]) {
@@ -125,13 +123,12 @@ fn the_studio_tier_sounds_like_the_reference_at_the_crest_keys() {
     }
 }
 
-/// The studio tier's hardest pluck at key 54 was the playing range's worst in band levels while
-/// the studio stepped at 2× the output rate (5.80 dB from the reference in the bench's grid,
-/// tuned as played; over the tier's 5 dB target); at 3× it lies within it (4.90 dB). Here, with
-/// the linearised tuning: 5.76 dB at 2×, 4.96 dB at 3×. The bench holds the 5 dB target; this
-/// test holds the pluck below 5.4 dB, halfway between the two steps, so that a return to 2×
-/// fails it with 0.4 dB to spare either way (the tuning's change from linearised to as played,
-/// a fraction of a cent, moves the figure by 0.06 dB).
+/// The hardest pluck at key 54 (0.35 m) is where the contact's time step shows: tuned by
+/// linearisation, the fine string lies 5.68 dB from the reference in band levels stepped at the
+/// output rate and 3.55 dB at twice it, the studio tier (`grid_against_refined --
+/// --fine-rates`, stop 56; the FD studio of stops 37–56 lay 4.96 dB from it at 3×, 5.76 dB at
+/// 2×). This test holds the studio's pluck below 5.4 dB, so that a studio stepped at the output
+/// rate fails it.
 #[test]
 fn the_studio_tiers_hardest_pluck_keeps_the_references_band_levels() {
     for (point, difference, _) in against_the_reference(Quality::Studio, &[54]) {

@@ -15,8 +15,8 @@
 //! (`javari_core::bowed::instrument` documents that mapping): CCs, channel and per-note pressure
 //! and pitch bend reach it too.
 //!
-//! Towards the host: the latency of the quality tier in use (the FD tiers' decimator delay, 29
-//! samples at 44.1 kHz; none for the modal tiers and the bowed string), set at activation
+//! Towards the host: the latency of the quality tier in use (the decimator's delay at the studio
+//! and reference tiers, 29 samples at 44.1 kHz; none for the other tiers and the bowed string), set at activation
 //! (`Engine::adopt_tier_latency`). When the tier changes while the plugin is active, `process`
 //! asks the host to restart it once, and the next activation reports the new latency: CLAP
 //! through `request_restart`, then `latency.changed` inside `activate` (never from the audio

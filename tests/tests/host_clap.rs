@@ -439,12 +439,12 @@ fn engine_latency(quality: Quality) -> u32 {
         .round() as u32
 }
 
-/// The plugin reports the latency of its tier (the FD tiers' decimator delay; none for the modal
-/// tiers). Automating the tier while processing asks the host for a restart when the latency
-/// changes (and only then); the next activation adopts the new latency, and the host hears of it
-/// through `latency.changed`, called inside `activate` as the CLAP spec requires (never outside:
-/// nice-plug 0.4.2 would do that for a latency set from `process` that reached it after a
-/// deactivation).
+/// The plugin reports the latency of its tier (the oversampled tiers' decimator delay, studio
+/// and reference; none for the tiers at the output rate). Automating the tier while processing
+/// asks the host for a restart when the latency changes (and only then); the next activation
+/// adopts the new latency, and the host hears of it through `latency.changed`, called inside
+/// `activate` as the CLAP spec requires (never outside: nice-plug 0.4.2 would do that for a
+/// latency set from `process` that reached it after a deactivation).
 #[test]
 fn clap_latency_follows_the_tier_through_a_restart() {
     let entry = load_entry();
@@ -460,10 +460,16 @@ fn clap_latency_follows_the_tier_through_a_restart() {
     let changes = |instance: &PluginInstance<TestHost>| {
         instance.access_handler(|host| host.latency_changes.get())
     };
-    let fd_latency = engine_latency(Quality::Reference);
-    println!("latency: {fd_latency} samples at 44.1 kHz at the FD tiers, 0 at the modal tiers");
-    assert!(fd_latency > 0, "the FD tiers have a decimator delay");
-    assert_eq!(engine_latency(Quality::Studio), fd_latency);
+    let reference_latency = engine_latency(Quality::Reference);
+    let studio_latency = engine_latency(Quality::Studio);
+    println!(
+        "latency at 44.1 kHz: {reference_latency} samples at the reference (4x), \
+         {studio_latency} at the studio tier (2x), 0 at the tiers at the output rate"
+    );
+    assert!(
+        studio_latency > 0 && reference_latency > 0,
+        "the oversampled tiers have a decimator delay"
+    );
     assert_eq!(engine_latency(Quality::Live), 0);
     assert_eq!(engine_latency(Quality::Fine), 0);
     assert_eq!(engine_latency(Quality::Draft), 0);

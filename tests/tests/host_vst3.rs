@@ -459,8 +459,8 @@ fn parameter_id(component: &ComPtr<IComponent>, title: &str) -> ParamID {
     }
 }
 
-/// The plugin reports the latency of its tier (the FD tiers' decimator delay; none for the modal
-/// tiers): automating the tier while it processes asks the host to restart it with
+/// The plugin reports the latency of its tier (the oversampled tiers' decimator delay, studio
+/// and reference; none for the others): automating the tier while it processes asks the host to restart it with
 /// `kLatencyChanged` when the latency changes (and only then), `getLatencySamples` returns the
 /// new latency, and the restart's activation adopts it without asking again.
 #[test]
@@ -480,8 +480,12 @@ fn vst3_latency_follows_the_tier_through_a_restart() {
     let latency_restart =
         || handler.restart_flags.swap(0, Ordering::SeqCst) & RestartFlags_::kLatencyChanged != 0;
     let latency = || unsafe { processor.getLatencySamples() };
-    let fd_latency = engine_latency(Quality::Reference);
-    assert!(fd_latency > 0, "the FD tiers have a decimator delay");
+    let reference_latency = engine_latency(Quality::Reference);
+    assert!(reference_latency > 0, "the reference has a decimator delay");
+    assert!(
+        engine_latency(Quality::Studio) > 0,
+        "so has the studio tier"
+    );
     assert_eq!(engine_latency(Quality::Live), 0);
     assert_eq!(engine_latency(Quality::Fine), 0);
 

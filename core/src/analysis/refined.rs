@@ -136,7 +136,8 @@ pub fn modal_pluck(
 pub struct ModalVariant {
     /// Residual modes (`docs/modal-tanpura.md` §8); the tiers have none.
     pub residual_modes: usize,
-    /// Steps per output sample, through the FD tiers' decimator; the tiers take one.
+    /// Steps per output sample, through the oversampled tiers' decimator (the studio tier takes
+    /// two).
     pub oversample: usize,
     /// The bridge's points every this many metres instead of the tier's spacing.
     pub bridge_point_spacing_m: Option<f64>,

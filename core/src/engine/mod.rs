@@ -28,8 +28,8 @@
 //!   through [`EngineEvent::sanitised`], so a non-finite or out-of-range value from automation
 //!   or MIDI is clamped (NaN takes the default) before it reaches a string;
 //! - the output latency a host must compensate ([`Engine::latency_samples`]): the latency of the
-//!   tier in use, the FD tiers' decimator delay (29 samples at 44.1 kHz) or none for the modal
-//!   tiers and the bowed string. It is fixed when the engine is built and when the plugin adopts
+//!   tier in use, the decimator's delay at the oversampled tiers, studio and reference (29
+//!   samples at 44.1 kHz), or none for the tiers at the output rate and the bowed string. It is fixed when the engine is built and when the plugin adopts
 //!   the tier's latency at activation ([`Engine::adopt_tier_latency`]); a change of tier
 //!   between two activations applies to each string from its next pluck, and the plugin asks
 //!   the host to restart it so that the reported latency follows ([`Engine::tier_latency_samples`]
@@ -113,7 +113,8 @@ impl OutputDelay {
 }
 
 /// The latency `settings` ask for, whole samples at the output rate: the tanpura's tier's own
-/// (the FD tiers' decimator delay, none for the modal tiers), none for the bowed string.
+/// (the oversampled tiers' decimator delay, none for the tiers at the output rate), none for the
+/// bowed string.
 fn tier_latency(slots: &[Slot], settings: &EngineSettings) -> usize {
     if settings.instrument == Instrument::Bowed {
         return 0;
@@ -851,9 +852,9 @@ impl Engine {
         self.latency as f64
     }
 
-    /// The latency the current settings ask for: the FD tiers' decimator delay (whole samples)
-    /// for the tanpura at the studio and reference tiers, none for the modal tiers and the
-    /// bowed string. When it differs from [`Engine::latency_samples`], the plugin asks the host
+    /// The latency the current settings ask for: the decimator's delay (whole samples) for the
+    /// tanpura at the oversampled tiers (studio and reference, 29 samples either at 44.1 kHz),
+    /// none for the tiers at the output rate and the bowed string. When it differs from [`Engine::latency_samples`], the plugin asks the host
     /// for a restart and adopts it at the next activation.
     pub fn tier_latency_samples(&self) -> f64 {
         tier_latency(&self.slots, &self.target) as f64

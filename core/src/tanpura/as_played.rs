@@ -54,17 +54,18 @@
 //!
 //! **One jawari for the instrument.** The thread's position is a setting of the instrument,
 //! not of the scheme that simulates it: a musician who plays in one tier and renders in another
-//! has set the jawari once. The studio tier's string rests exactly where the reference's rests
-//! (the FD rest preload, `fd/mod.rs`), so its jawari is set on the reference's scheme
-//! ([`jawari_set_on`]): the studio's calibration takes the reference's thread move for the same
-//! string and pluck and centres its own tension on it ([`as_played_with_jawari`]). Set on its
-//! own scheme it could differ by a step: at key 54 plucked at 0.20 m the window of bistable
-//! thread positions lies a fraction of a step apart in the two schemes, the studio settled at
-//! +0.25 mm and the reference at +0.30 mm, and the softest touch (velocity 1) then stayed on the
-//! crest in one and not in the other, 14.8 cents apart; at +0.30 mm both lie within 0.12 cents of
-//! each other at every velocity 1–127 (`examples/as_played.rs`). The modal tiers keep their
-//! own: their string rests 7 µm above the crest (`docs/modal-tanpura.md` §8), so the reference's
-//! thread would not set the same contact on it.
+//! has set the jawari once. The fine and studio tiers' string (the reference's grid modes and
+//! points, `modal/nodal_statics.rs`) rests where the reference's rests, so their jawari is set
+//! on the reference's scheme ([`jawari_set_on`]): their calibration takes the reference's thread
+//! move for the same string and pluck and centres its own tension on it
+//! ([`as_played_with_jawari`]). Set on its own scheme it could differ by a step: at key 54
+//! plucked at 0.20 m the window of bistable thread positions lies a fraction of a step apart in
+//! two schemes, the FD studio of stops 34–56 settled at +0.25 mm and the reference at +0.30 mm,
+//! and the softest touch (velocity 1) then stayed on the crest in one and not in the other,
+//! 14.8 cents apart; at +0.30 mm both lay within 0.12 cents of each other at every velocity
+//! 1–127 (`examples/as_played.rs`). The draft and live tiers keep their own: their string rests
+//! 7 µm above the crest (`docs/modal-tanpura.md` §8), so the reference's thread would not set
+//! the same contact on it.
 //!
 //! The first pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, the second
 //! three, each thread move tried two more and the one kept three more again, so a calibration

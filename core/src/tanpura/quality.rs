@@ -1,6 +1,6 @@
 //! Quality tiers: which discretisation a tanpura voice runs, and at what resolution.
 //!
-//! - Draft and Live run the modal scheme (`modal/`, `docs/modal-tanpura.md`): the string's
+//! - Draft, Live and Fine run the modal scheme (`modal/`, `docs/modal-tanpura.md`): the string's
 //!   eigenmodes advanced by exact two-pole recursions at the output rate (exact partials and decay
 //!   rates, no oversampling, no decimator, no latency), in f32 over the modes, with the contact
 //!   force on a few points of the bridge and thread solved by Newton in f64. Live keeps the modes
@@ -26,14 +26,20 @@
 //!   the same points (`docs/modal-tanpura.md` §10, stop 50; worst pluck of the playing range,
 //!   linearised tuning: 5.68 dB against 7.74 dB with points every 0.36 / 0.2 mm from the fine
 //!   string's own start, median 1.28 against 1.97 dB, for 18–26 % of the tier's speed).
-//! - Studio and Reference run the seed's finite-difference scheme (`fd/`). Reference is the
-//!   seed's own discretisation (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm,
-//!   Δx_c = 0.15 mm) with a tolerance at round-off; Studio runs at 3 × 44.1 kHz and keeps the
-//!   seed's grids. At 2× its hard plucks' band levels lay up to 5.8 dB from the reference's over
-//!   the playing range; at 3× 4.9 dB, within the 5 dB the tier is held to, for 1.33–1.41 times
-//!   the cost (`docs/tiers-log.md`, stop 37). Studio's EI is raised so that its inharmonicity matches the
-//!   reference's (`voice.rs`, `dispersion_compensated_stiffness`), for the vibration only: its
-//!   string rests where the reference's rests (the FD rest preload, `fd/mod.rs`).
+//! - Studio runs the fine tier's string stepped at twice the output rate (its grid modes keep
+//!   the poles of the reference's time step; the contact is solved every half output sample),
+//!   decimated by the reference's Kaiser filter (`fd/decimator.rs`, 29 samples of latency at
+//!   44.1 kHz, as the reference's). The rest of the fine tier's distance from the reference at its worst plucks is
+//!   the contact's time step: over the playing range, tuned by linearisation, the fine string
+//!   lies 0.53 cents, 5.68 dB and 12.6 % from the reference at worst at the output rate and
+//!   0.10 cents, 3.55 dB and 5.8 % at twice it (`docs/modal-tanpura.md` §12, stop 56). Until
+//!   stop 57 the studio tier was the seed's FD scheme at 3 × 44.1 kHz (with its EI raised to
+//!   match the reference's dispersion): 4.9 dB at worst and 4.5× real time per string, slower
+//!   and less accurate than the modal string at twice the rate, so it was replaced
+//!   (`docs/tiers-log.md`, stop 57).
+//! - Reference runs the seed's finite-difference scheme (`fd/`), its own discretisation
+//!   (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm, Δx_c = 0.15 mm) with a tolerance at
+//!   round-off.
 //!
 //! Every tier keeps its scheme's exact discrete energy balance; the balance holds only for a
 //! converged Newton: a tolerance of 1e-8 m let an FD tier's energy grow by 0.3 % per step at
@@ -68,6 +74,10 @@ pub struct ModalTier {
     /// Take the reference's FD grid's modes with the contact condensed on its nodes
     /// (`modal/nodal.rs`) instead of the continuous string's modes.
     pub grid_modes: bool,
+    /// Steps per output sample: the contact is solved at this multiple of the output rate and
+    /// the pickup decimated by the reference's Kaiser filter (`fd/decimator.rs`); 1 runs at the
+    /// output rate with no decimator and no latency.
+    pub oversample: usize,
 }
 
 /// The numerical choices of one finite-difference tier.
@@ -104,6 +114,17 @@ pub fn reference_grid_modes(output_sample_rate_hz: f64) -> GridModes {
     }
 }
 
+/// The fine tier: the reference's grid modes and barrier points, stepped at the output rate.
+/// The studio tier is the same string stepped at twice the output rate.
+const FINE_GRID: ModalTier = ModalTier {
+    highest_mode_hz: 20_000.0,
+    bridge_point_spacing_m: 0.18e-3,
+    thread_point_spacing_m: 0.15e-3,
+    newton: TIER_NEWTON,
+    grid_modes: true,
+    oversample: 1,
+};
+
 /// Newton's tolerance and cap in every tier but the reference.
 const TIER_NEWTON: NewtonSettings = NewtonSettings {
     tolerance_m: 1e-12,
@@ -127,6 +148,7 @@ impl Quality {
                 thread_point_spacing_m: 1e-3,
                 newton: TIER_NEWTON,
                 grid_modes: false,
+                oversample: 1,
             }),
             Quality::Live => Tier::Modal(ModalTier {
                 highest_mode_hz: 20_000.0,
@@ -134,20 +156,12 @@ impl Quality {
                 thread_point_spacing_m: 0.5e-3,
                 newton: TIER_NEWTON,
                 grid_modes: false,
+                oversample: 1,
             }),
-            Quality::Fine => Tier::Modal(ModalTier {
-                highest_mode_hz: 20_000.0,
-                bridge_point_spacing_m: 0.18e-3,
-                thread_point_spacing_m: 0.15e-3,
-                newton: TIER_NEWTON,
-                grid_modes: true,
-            }),
-            Quality::Studio => Tier::FiniteDifference(FdTier {
-                oversample: 3,
-                intervals: 200,
-                barrier_spacing_scale: 1.0,
-                newton: TIER_NEWTON,
-                solver: SolverKind::Condensed,
+            Quality::Fine => Tier::Modal(FINE_GRID),
+            Quality::Studio => Tier::Modal(ModalTier {
+                oversample: 2,
+                ..FINE_GRID
             }),
             Quality::Reference => Tier::FiniteDifference(FdTier {
                 oversample: 4,
@@ -175,9 +189,12 @@ impl Quality {
         }
     }
 
-    /// Internal steps per output sample (1 for the modal tiers).
+    /// Internal steps per output sample.
     pub fn oversample(self) -> usize {
-        self.fd_tier().map_or(1, |tier| tier.oversample)
+        match self.tier() {
+            Tier::FiniteDifference(tier) => tier.oversample,
+            Tier::Modal(tier) => tier.oversample,
+        }
     }
 
     /// Position in [`Quality::ALL`].
@@ -233,9 +250,36 @@ mod tests {
         assert!(draft.bridge_point_spacing_m >= live.bridge_point_spacing_m);
         assert!(draft.thread_point_spacing_m > live.thread_point_spacing_m);
         assert_eq!(Quality::Live.oversample(), 1);
-        let studio = Quality::Studio.fd_tier().unwrap();
-        let reference = Quality::Reference.fd_tier().unwrap();
-        assert!(studio.oversample < reference.oversample);
+        assert_eq!(Quality::Fine.oversample(), 1);
+    }
+
+    /// The studio tier is the fine tier's string (its grid modes with the poles of the
+    /// reference's time step, its points, its Newton) stepped at twice the output rate.
+    #[test]
+    fn studio_is_the_fine_string_at_twice_the_rate() {
+        let fine = Quality::Fine.modal_tier().unwrap();
+        let studio = Quality::Studio.modal_tier().unwrap();
+        assert_eq!(
+            studio,
+            ModalTier {
+                oversample: 2,
+                ..fine
+            }
+        );
+        assert_eq!(Quality::Studio.oversample(), 2);
+        let settings = crate::tanpura::VoiceSettings::default();
+        let rate = 44_100.0;
+        let fine = settings.modal_config_at(Quality::Fine, rate).unwrap();
+        let studio = settings.modal_config_at(Quality::Studio, rate).unwrap();
+        assert_eq!(studio.time_step_s, 0.5 / rate);
+        assert_eq!(studio.grid_modes, Some(reference_grid_modes(rate)));
+        assert_eq!(
+            crate::tanpura::modal::ModalStringConfig {
+                time_step_s: fine.time_step_s,
+                ..studio
+            },
+            fine
+        );
     }
 
     #[test]

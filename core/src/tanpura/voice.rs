@@ -2,22 +2,23 @@
 //!
 //! A voice holds one string per quality tier (`quality.rs`), all built up front, so switching
 //! tiers never allocates; only the selected tier's string is computed, and switching starts it
-//! at rest. The draft and live tiers run the modal scheme ([`ModalString`], at the output rate,
-//! no latency), studio and reference the seed's FD scheme ([`FdString`]) at `oversample ×` the
-//! output rate (seed 000: 4 × 44.1 kHz), brought down by a Kaiser-windowed FIR (`decimator.rs`).
+//! at rest. The draft, live and fine tiers run the modal scheme ([`ModalString`], at the output
+//! rate, no latency), the studio tier the fine tier's modal string at twice the output rate, and
+//! the reference the seed's FD scheme ([`FdString`]) at 4 × the output rate (seed 000:
+//! 4 × 44.1 kHz); an oversampled tier is brought down by a Kaiser-windowed FIR (`decimator.rs`).
 //!
 //! A voice maps musician-facing settings in SI units onto either string: the tension follows
 //! the pitch, `T = ρA (2 L_s f)² / (1 + B)` with the speaking length `L_s` from the thread (or the
 //! bridge crest) to the nut and the stiff-string correction `B = π² EI / (T L_s²)` (solved by a
 //! fixed-point pass), then two passes on the linearised fundamental of the string resting on
-//! bridge and thread. The studio tier's EI is raised so that its dispersion matches the
-//! reference's; the reference keeps the seed's EI; the modal tiers have no dispersion. The output is the
-//! pickup mix of the nut force (eq. 13) and the bridge force (eq. 12) minus their values at
+//! bridge and thread. An FD tier coarser than the reference would have its EI raised so that its
+//! dispersion matches the reference's; the reference keeps the seed's EI; the modal tiers have
+//! no dispersion. The output is the pickup mix of the nut force (eq. 13) and the bridge force (eq. 12) minus their values at
 //! rest, so a silent string outputs exactly 0 and carries no DC.
 //!
 //! A voice whose vibration energy has fallen below [`SLEEP_ENERGY_J`] (−86 dB below a typical
 //! pluck) is put exactly at rest and sleeps: no computation at all until its next pluck, once the
-//! decimator's tail (FD tiers) has been flushed.
+//! decimator's tail (oversampled tiers) has been flushed.
 
 use super::excitation::Pluck;
 use super::fd::decimator::Decimator;
@@ -235,17 +236,6 @@ impl VoiceSettings {
             ..ThreadSettings::SEED
         });
         config.string = self.string_parameters(config.speaking_start_m());
-        // The raised EI is the vibration's; the string rests as the true one does.
-        config.rest_bending_stiffness_n_m2 = Some(config.string.bending_stiffness_n_m2);
-        config.string.bending_stiffness_n_m2 = dispersion_compensated_stiffness(
-            quality,
-            &config.string,
-            config.speaking_start_m(),
-            config.string.length_m / config.intervals as f64,
-            config.time_step_s,
-            self.fundamental_hz,
-            output_sample_rate_hz,
-        );
         config.newton = tier.newton;
         config.solver = tier.solver;
         Some(config)
@@ -253,7 +243,9 @@ impl VoiceSettings {
 
     /// The modal string configuration these settings describe at a modal tier and
     /// `output_sample_rate_hz`; `None` for an FD tier. The modal scheme has no dispersion, so the
-    /// string keeps its own EI.
+    /// string keeps its own EI. A tier stepped at a multiple of the output rate keeps the grid
+    /// modes of the output rate's reference (their poles are those of the reference's own time
+    /// step, whatever the modal step).
     pub fn modal_config_at(
         &self,
         quality: Quality,
@@ -261,7 +253,7 @@ impl VoiceSettings {
     ) -> Option<ModalStringConfig> {
         let tier = quality.modal_tier()?;
         let mut config = ModalStringConfig::REFERENCE;
-        config.time_step_s = 1.0 / output_sample_rate_hz;
+        config.time_step_s = 1.0 / (output_sample_rate_hz * tier.oversample as f64);
         config.highest_mode_hz = tier.highest_mode_hz;
         config.bridge_point_spacing_m = tier.bridge_point_spacing_m;
         config.thread_point_spacing_m = tier.thread_point_spacing_m;
@@ -309,67 +301,8 @@ pub fn tension_for_pitch_n(
     tension
 }
 
-/// Relative flattening of partial n, per n², that the FD scheme's discretisation causes at a
-/// fundamental `fundamental_hz` over the speaking length `speaking_m`: `(πΔx/L_s)²/24` from the
-/// second difference in space and `(2πf₀Δt)²/12` from the trapezoidal rule in time (both
-/// lower the frequencies; the leading terms of their Taylor series).
-fn dispersion_per_n_squared(
-    spacing_m: f64,
-    time_step_s: f64,
-    speaking_m: f64,
-    fundamental_hz: f64,
-) -> f64 {
-    let space = (std::f64::consts::PI * spacing_m / speaking_m).powi(2) / 24.0;
-    let time = (2.0 * std::f64::consts::PI * fundamental_hz * time_step_s).powi(2) / 12.0;
-    space + time
-}
-
-/// The bending stiffness that gives an FD tier the same n² inharmonicity as the reference tier.
-///
-/// Stiffness raises partial n by `B n²/2` (relative, `B = π² EI/(T L_s²)`), the discretisation
-/// lowers it by `c n²` (see [`dispersion_per_n_squared`]). A coarser tier has a larger `c`; raising
-/// its `B` by `2(c_tier − c_reference)` cancels the difference to leading order, so the first ten
-/// partials of every FD tier stay close to the reference's. The reference keeps the seed's EI
-/// (its own dispersion flattens the tenth partial by about 2.6 cents against the continuous
-/// string by the leading-order estimate above, which the modal tiers reproduce exactly).
-///
-/// The raised EI is the vibration's: the rest state is solved with the true EI
-/// ([`FdStringConfig::rest_bending_stiffness_n_m2`]). Raised everywhere, it made the studio
-/// string's static shape near the thread differ from the reference's by micrometres and
-/// decided differently which keys rest on the crest (its worst sustained pitch over the
-/// playing range, 14.7 cents at key 54, was that; `docs/tiers-log.md`, stop 34).
-fn dispersion_compensated_stiffness(
-    quality: Quality,
-    string: &StringParameters,
-    speaking_start_m: f64,
-    spacing_m: f64,
-    time_step_s: f64,
-    fundamental_hz: f64,
-    output_sample_rate_hz: f64,
-) -> f64 {
-    if quality == Quality::Reference {
-        return string.bending_stiffness_n_m2;
-    }
-    let speaking = string.length_m - speaking_start_m;
-    let Some(reference) = Quality::Reference.fd_tier() else {
-        return string.bending_stiffness_n_m2;
-    };
-    let reference_dispersion = dispersion_per_n_squared(
-        string.length_m / reference.intervals as f64,
-        1.0 / (output_sample_rate_hz * reference.oversample as f64),
-        speaking,
-        fundamental_hz,
-    );
-    let dispersion = dispersion_per_n_squared(spacing_m, time_step_s, speaking, fundamental_hz);
-    let pi2 = std::f64::consts::PI.powi(2);
-    let tension_l2 = string.tension_n * speaking * speaking;
-    let inharmonicity = pi2 * string.bending_stiffness_n_m2 / tension_l2
-        + 2.0 * (dispersion - reference_dispersion);
-    inharmonicity * tension_l2 / pi2
-}
-
-/// One tanpura string with its tier's discretisation (and the FD tiers' oversampling and
-/// decimation); allocation-free after `new`.
+/// One tanpura string with its tier's discretisation (and the oversampled tiers' decimation);
+/// allocation-free after `new`.
 #[derive(Debug, Clone)]
 pub struct TanpuraVoice {
     settings: VoiceSettings,
@@ -614,7 +547,7 @@ impl TanpuraVoice {
             return output as f32;
         }
         let output = if oversample == 1 {
-            // The modal tiers run at the output rate: no decimator, no latency.
+            // A tier at the output rate: no decimator, no latency.
             self.string_mut().step();
             self.pickup_internal_n()
         } else {
@@ -650,16 +583,16 @@ impl TanpuraVoice {
     }
 
     /// Fills `output` with consecutive samples (overwrites): [`TanpuraVoice::next_sample`]'s
-    /// samples bit for bit. A ringing modal string runs its steps between sleep checks as one
-    /// call ([`ModalString::step_into`]: one dispatch to the vector unit for the run, not one a
+    /// samples bit for bit. A ringing modal string at the output rate runs its steps between
+    /// sleep checks as one call ([`ModalString::step_into`]: one dispatch to the vector unit for the run, not one a
     /// sample).
     pub fn process(&mut self, output: &mut [f32]) {
         let nut_weight = self.settings.nut_pickup_weight;
         let mut done = 0;
         while done < output.len() {
             let until_check = SLEEP_CHECK_INTERVAL.saturating_sub(self.samples_since_sleep_check);
-            let sleeping = self.sleeping;
-            if let (false, TierString::Modal(string)) = (sleeping, self.string_mut()) {
+            let at_output_rate = !self.sleeping && self.oversample() == 1;
+            if let (true, TierString::Modal(string)) = (at_output_rate, self.string_mut()) {
                 let run = (until_check.max(1) as usize).min(output.len() - done);
                 string.step_into(&mut output[done..done + run], nut_weight);
                 done += run;
@@ -712,8 +645,8 @@ impl TanpuraVoice {
         self.string().newton_stats()
     }
 
-    /// Output latency, samples at the output rate: the decimation filter's delay for the FD
-    /// tiers, none for the modal tiers.
+    /// Output latency, samples at the output rate: the decimation filter's delay for the
+    /// oversampled tiers (studio and reference), none for the tiers at the output rate.
     pub fn latency_samples(&self) -> f64 {
         self.latency_samples_at(self.settings.quality)
     }

@@ -28,8 +28,9 @@
 //! deepest penetration is computed when asked for from what the last step left in the barrier
 //! grids.
 //!
-//! **Rest preload** (not in the seed; the studio tier's). A tier that raises EI to cancel its
-//! coarser time step's dispersion (`voice.rs`) would also change the string's static shape near
+//! **Rest preload** (not in the seed; the FD studio tier's until stop 57, when the studio tier
+//! became modal). A tier that raises EI to cancel its coarser time step's dispersion would also
+//! change the string's static shape near
 //! the thread by micrometres, and with it which keys rest on the bridge's crest. With
 //! [`FdStringConfig::rest_bending_stiffness_n_m2`] the rest state `ȳ` is solved with the true EI
 //! and a constant force density `p = g(ȳ) − g_true(ȳ)` (`g = K y − b` of `operator.rs`) is added,

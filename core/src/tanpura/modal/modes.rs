@@ -20,7 +20,7 @@
 //! rule moves them (the bilinear transform at Δt_FD: [`trapezoidal_equivalent`]; without losses
 //! `(2/Δt_FD) atan(ω_k Δt_FD/2)`) in the recursion, shapes at a point by the FD's cubic
 //! Lagrange interpolation of the nodes, and the nut weight the FD operator's nut force of the
-//! sampled sine (zero above the output band, which the FD tiers' decimator removes).
+//! sampled sine (zero above the output band, which the reference's decimator removes).
 
 use crate::tanpura::fd::barrier_grid::lagrange_stencil;
 use crate::tanpura::string::StringParameters;
@@ -278,7 +278,7 @@ impl ModeSet {
             self.kinetic_factor[index] = a / (2.0 * b);
             self.loss_factor[index] = (1.0 - det) / (2.0 * b);
             // Grid modes above the output band still move the string (the contact, the static
-            // problems) but are not heard at the nut, as the FD tiers' decimator removes them;
+            // problems) but are not heard at the nut, as the reference's decimator removes them;
             // sounded, they would alias into the top octave.
             self.nut_weight[index] = if grid.is_none() || heard_omega / (2.0 * PI) < limit_hz {
                 nut_force / root
