@@ -16,15 +16,15 @@
 //! and pitch bend reach it too.
 //!
 //! Towards the host: the latency of the quality tier in use (the decimator's delay at the studio
-//! and reference tiers, 29 samples at 44.1 kHz; none for the other tiers and the bowed string), set at activation
-//! (`Engine::adopt_tier_latency`). When the tier changes while the plugin is active, `process`
-//! asks the host to restart it once, and the next activation reports the new latency: CLAP
-//! through `request_restart`, then `latency.changed` inside `activate` (never from the audio
+//! and reference tiers, 29 samples at 44.1 kHz; none for the other tiers and the bowed string), set
+//! at activation (`Engine::adopt_tier_latency`). When the tier changes while the plugin is active,
+//! `process` asks the host to restart it once, and the next activation reports the new latency:
+//! CLAP through `request_restart`, then `latency.changed` inside `activate` (never from the audio
 //! thread's change itself: nice-plug 0.4.2 would call it after a deactivation that raced it,
 //! outside `activate`, which the CLAP spec forbids); VST3 through
 //! `restartComponent(kLatencyChanged)`. Until the restart, a string keeps sounding at the latency
-//! reported (a modal string plucked at an FD latency is delayed to it). A state blob is
-//! repaired before it loads ([`state`]);
+//! reported (a modal string plucked at an FD latency is delayed to it). A state blob is repaired
+//! before it loads ([`state`]);
 //! `process` runs with subnormals flushed to zero (`javari_core::denormals`).
 //!
 //! Each string is tuned by its sustained pitch as played once [`tuning_worker`] has measured

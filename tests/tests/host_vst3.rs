@@ -459,10 +459,10 @@ fn parameter_id(component: &ComPtr<IComponent>, title: &str) -> ParamID {
     }
 }
 
-/// The plugin reports the latency of its tier (the oversampled tiers' decimator delay, studio
-/// and reference; none for the others): automating the tier while it processes asks the host to restart it with
-/// `kLatencyChanged` when the latency changes (and only then), `getLatencySamples` returns the
-/// new latency, and the restart's activation adopts it without asking again.
+/// The plugin reports the latency of its tier (the oversampled tiers' decimator delay, studio and
+/// reference; none for the others): automating the tier while it processes asks the host to restart
+/// it with `kLatencyChanged` when the latency changes (and only then), `getLatencySamples` returns
+/// the new latency, and the restart's activation adopts it without asking again.
 #[test]
 fn vst3_latency_follows_the_tier_through_a_restart() {
     let module = module();

@@ -28,14 +28,15 @@
 //!   through [`EngineEvent::sanitised`], so a non-finite or out-of-range value from automation
 //!   or MIDI is clamped (NaN takes the default) before it reaches a string;
 //! - the output latency a host must compensate ([`Engine::latency_samples`]): the latency of the
-//!   tier in use, the decimator's delay at the oversampled tiers, studio and reference (29
-//!   samples at 44.1 kHz), or none for the tiers at the output rate and the bowed string. It is fixed when the engine is built and when the plugin adopts
-//!   the tier's latency at activation ([`Engine::adopt_tier_latency`]); a change of tier
-//!   between two activations applies to each string from its next pluck, and the plugin asks
-//!   the host to restart it so that the reported latency follows ([`Engine::tier_latency_samples`]
-//!   says what it will be). A voice whose own latency is lower than the reported one is delayed
-//!   to match (`OutputDelay`); one whose latency is higher (an FD string still ringing after a
-//!   switch to a modal tier, until the host restarts the plugin) sounds that much late.
+//!   tier in use, the decimator's delay at the oversampled tiers, studio and reference (29 samples
+//!   at 44.1 kHz), or none for the tiers at the output rate and the bowed string. It is fixed when
+//!   the engine is built and when the plugin adopts the tier's latency at activation
+//!   ([`Engine::adopt_tier_latency`]); a change of tier between two activations applies to each
+//!   string from its next pluck, and the plugin asks the host to restart it so that the reported
+//!   latency follows ([`Engine::tier_latency_samples`] says what it will be). A voice whose own
+//!   latency is lower than the reported one is delayed to match (`OutputDelay`); one whose latency
+//!   is higher (an FD string still ringing after a switch to a modal tier, until the host restarts
+//!   the plugin) sounds that much late.
 //!
 //! Lifecycle (design.md): [`Engine::new`] allocates every voice; [`Engine::process`],
 //! [`Engine::set_settings`], [`Engine::set_host_tempo`] and [`Engine::reset`] never allocate,
@@ -854,8 +855,9 @@ impl Engine {
 
     /// The latency the current settings ask for: the decimator's delay (whole samples) for the
     /// tanpura at the oversampled tiers (studio and reference, 29 samples either at 44.1 kHz),
-    /// none for the tiers at the output rate and the bowed string. When it differs from [`Engine::latency_samples`], the plugin asks the host
-    /// for a restart and adopts it at the next activation.
+    /// none for the tiers at the output rate and the bowed string. When it differs from
+    /// [`Engine::latency_samples`], the plugin asks the host for a restart and adopts it at the
+    /// next activation.
     pub fn tier_latency_samples(&self) -> f64 {
         tier_latency(&self.slots, &self.target) as f64
     }

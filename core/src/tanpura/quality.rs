@@ -26,17 +26,16 @@
 //!   the same points (`docs/modal-tanpura.md` §10, stop 50; worst pluck of the playing range,
 //!   linearised tuning: 5.68 dB against 7.74 dB with points every 0.36 / 0.2 mm from the fine
 //!   string's own start, median 1.28 against 1.97 dB, for 18–26 % of the tier's speed).
-//! - Studio runs the fine tier's string stepped at twice the output rate (its grid modes keep
-//!   the poles of the reference's time step; the contact is solved every half output sample),
-//!   decimated by the reference's Kaiser filter (`fd/decimator.rs`, 29 samples of latency at
-//!   44.1 kHz, as the reference's). The rest of the fine tier's distance from the reference at its worst plucks is
-//!   the contact's time step: over the playing range, tuned by linearisation, the fine string
-//!   lies 0.53 cents, 5.68 dB and 12.6 % from the reference at worst at the output rate and
-//!   0.10 cents, 3.55 dB and 5.8 % at twice it (`docs/modal-tanpura.md` §12, stop 56). Until
-//!   stop 57 the studio tier was the seed's FD scheme at 3 × 44.1 kHz (with its EI raised to
-//!   match the reference's dispersion): 4.9 dB at worst and 4.5× real time per string, slower
-//!   and less accurate than the modal string at twice the rate, so it was replaced
-//!   (`docs/tiers-log.md`, stop 57).
+//! - Studio runs the fine tier's string stepped at twice the output rate (its grid modes keep the
+//!   poles of the reference's time step; the contact is solved every half output sample), decimated
+//!   by the reference's Kaiser filter (`fd/decimator.rs`, 29 samples of latency at 44.1 kHz, as the
+//!   reference's). The rest of the fine tier's distance from the reference at its worst plucks is
+//!   the contact's time step: over the playing range, tuned by linearisation, the fine string lies
+//!   0.53 cents, 5.68 dB and 12.6 % from the reference at worst at the output rate and 0.10 cents,
+//!   3.55 dB and 5.8 % at twice it (`docs/modal-tanpura.md` §12, stop 56). Until stop 57 the studio
+//!   tier was the seed's FD scheme at 3 × 44.1 kHz (with its EI raised to match the reference's
+//!   dispersion): 4.9 dB at worst and 4.5× real time per string, slower and less accurate than the
+//!   modal string at twice the rate, so it was replaced (`docs/tiers-log.md`, stop 57).
 //! - Reference runs the seed's finite-difference scheme (`fd/`), its own discretisation
 //!   (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm, Δx_c = 0.15 mm) with a tolerance at
 //!   round-off.

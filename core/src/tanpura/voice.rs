@@ -7,14 +7,14 @@
 //! the reference the seed's FD scheme ([`FdString`]) at 4 × the output rate (seed 000:
 //! 4 × 44.1 kHz); an oversampled tier is brought down by a Kaiser-windowed FIR (`decimator.rs`).
 //!
-//! A voice maps musician-facing settings in SI units onto either string: the tension follows
-//! the pitch, `T = ρA (2 L_s f)² / (1 + B)` with the speaking length `L_s` from the thread (or the
+//! A voice maps musician-facing settings in SI units onto either string: the tension follows the
+//! pitch, `T = ρA (2 L_s f)² / (1 + B)` with the speaking length `L_s` from the thread (or the
 //! bridge crest) to the nut and the stiff-string correction `B = π² EI / (T L_s²)` (solved by a
-//! fixed-point pass), then two passes on the linearised fundamental of the string resting on
-//! bridge and thread. An FD tier coarser than the reference would have its EI raised so that its
-//! dispersion matches the reference's; the reference keeps the seed's EI; the modal tiers have
-//! no dispersion. The output is the pickup mix of the nut force (eq. 13) and the bridge force (eq. 12) minus their values at
-//! rest, so a silent string outputs exactly 0 and carries no DC.
+//! fixed-point pass), then two passes on the linearised fundamental of the string resting on bridge
+//! and thread. The reference keeps the seed's EI with its grid's dispersion, which the fine and
+//! studio tiers' grid modes share; the other modal tiers have none. The output is the pickup mix of
+//! the nut force (eq. 13) and the bridge force (eq. 12) minus their values at rest, so a silent
+//! string outputs exactly 0 and carries no DC.
 //!
 //! A voice whose vibration energy has fallen below [`SLEEP_ENERGY_J`] (−86 dB below a typical
 //! pluck) is put exactly at rest and sleeps: no computation at all until its next pluck, once the
@@ -583,9 +583,9 @@ impl TanpuraVoice {
     }
 
     /// Fills `output` with consecutive samples (overwrites): [`TanpuraVoice::next_sample`]'s
-    /// samples bit for bit. A ringing modal string at the output rate runs its steps between
-    /// sleep checks as one call ([`ModalString::step_into`]: one dispatch to the vector unit for the run, not one a
-    /// sample).
+    /// samples bit for bit. A ringing modal string at the output rate runs its steps between sleep
+    /// checks as one call ([`ModalString::step_into`]: one dispatch to the vector unit for the run,
+    /// not one a sample).
     pub fn process(&mut self, output: &mut [f32]) {
         let nut_weight = self.settings.nut_pickup_weight;
         let mut done = 0;

@@ -30,14 +30,13 @@
 //!
 //! **Rest preload** (not in the seed; the FD studio tier's until stop 57, when the studio tier
 //! became modal). A tier that raises EI to cancel its coarser time step's dispersion would also
-//! change the string's static shape near
-//! the thread by micrometres, and with it which keys rest on the bridge's crest. With
-//! [`FdStringConfig::rest_bending_stiffness_n_m2`] the rest state `ȳ` is solved with the true EI
-//! and a constant force density `p = g(ȳ) − g_true(ȳ)` (`g = K y − b` of `operator.rs`) is added,
-//! so that `g(ȳ) − p` is the true string's restoring force at rest: `ȳ` is an equilibrium of
-//! the scheme and the raised EI acts on the motion about it. `p` is constant, so the potential
-//! gains `−Δx Σ p_m y_m` (its gradient is exact) and the energy balance below holds unchanged
-//! (tested).
+//! change the string's static shape near the thread by micrometres, and with it which keys rest on
+//! the bridge's crest. With [`FdStringConfig::rest_bending_stiffness_n_m2`] the rest state `ȳ` is
+//! solved with the true EI and a constant force density `p = g(ȳ) − g_true(ȳ)` (`g = K y − b` of
+//! `operator.rs`) is added, so that `g(ȳ) − p` is the true string's restoring force at rest: `ȳ` is
+//! an equilibrium of the scheme and the raised EI acts on the motion about it. `p` is constant, so
+//! the potential gains `−Δx Σ p_m y_m` (its gradient is exact) and the energy balance below holds
+//! unchanged (tested).
 //!
 //! Energy (eq. 8–9): `H = Σ Δx [p²/2ρA] + V_string + Δx_b Σ k_b/2⌊a⌋² + Δx_c Σ k_c/2⌊a⌋²`.
 //! The scheme gives `Hⁿ⁺¹ − Hⁿ = −(losses over the step)` exactly; a pluck changes H by the
