@@ -603,3 +603,48 @@ fn a_change_of_the_losses_alone_keeps_the_thread_lattice_with_one_static_solve()
         }
     }
 }
+
+/// The studio tier's own string (`docs/modal-tanpura.md` §13: the fine tier's, with the modal
+/// step halved): lossless, H is conserved to 1e-10 in contact; lossy, `H + losses = H₀` to
+/// 1e-10 and H never rises. Half a second at its step of 1/88 200 s.
+#[test]
+fn the_studio_tiers_string_keeps_the_balance_at_its_own_step() {
+    use javari_core::tanpura::quality::Quality;
+    use javari_core::tanpura::VoiceSettings;
+    let settings = VoiceSettings {
+        quality: Quality::Studio,
+        ..VoiceSettings::default()
+    };
+    let mut config = settings
+        .modal_config_at(Quality::Studio, SAMPLE_RATE)
+        .expect("the studio tier is modal");
+    config.track_energy = true;
+    assert_eq!(config.time_step_s, 0.5 / SAMPLE_RATE);
+    // Half a second: as many steps as a second has samples.
+    let steps = SAMPLE_RATE as usize;
+
+    let mut lossless = plucked::<f64>(config.lossless());
+    assert!(lossless.contact_node_count() > 0, "condensed on the nodes");
+    let initial = lossless.energy_j();
+    let mut worst = 0.0f64;
+    for _ in 0..steps {
+        lossless.step();
+        worst = worst.max((lossless.energy_j() - initial).abs() / initial);
+    }
+    let stats = *lossless.newton_stats();
+    assert!(
+        stats.steps_without_contact < stats.steps / 10,
+        "the balance is tested in contact: {stats:?}"
+    );
+    assert!(worst <= 1e-10, "lossless: relative energy drift {worst:e}");
+
+    // `lossy_run` takes seconds at the output rate; the studio takes two steps a sample.
+    let (string, worst_increase, worst_balance) = lossy_run(config, steps as f64 / SAMPLE_RATE);
+    assert!(string.cumulative_losses_j() > 0.0);
+    assert!(
+        worst_increase <= 1e-14,
+        "H increased by {worst_increase:e} of H(0)"
+    );
+    assert!(worst_balance <= 1e-10, "balance error {worst_balance:e}");
+    assert_eq!(string.newton_stats().cap_hits, 0);
+}
