@@ -316,7 +316,8 @@ fn the_studio_plays_the_jawari_the_reference_sets() {
     }
 }
 
-/// Key 53, off the bench's grid (every third key), is bistable at hard plucks: as played, the
+/// Key 53 (on the bench's grid since stop 57, which takes every crest key; every third key
+/// before) is bistable at hard plucks: as played, the
 /// reference's pluck at velocity 127 stays on the branch 2.6 cents above its pluck at 110. The
 /// studio tier, the fine string stepped at twice the output rate, follows it at both velocities
 /// (measured: within 0.5 cents); the fine tier, stepped at the output rate, takes the other

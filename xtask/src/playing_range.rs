@@ -381,10 +381,10 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
 pub fn to_markdown(results: &[TierOverGrid]) -> String {
     let grid = full_grid();
     let mut text = format!(
-        "\nAcross the playing range ({} single plucks: keys 36–64 every third semitone and 64, \
-         velocities 1/40/80/127, plucks at 0.35 and 0.20 m; {:.1} s each, against the reference \
-         render of the same pluck; measures defined in `core/src/analysis/listening.rs`), worst / \
-         median over the grid:\n\n\
+        "\nAcross the playing range ({} single plucks: keys 36–64 every third semitone and 64 \
+         and every crest key 48–54, velocities 1/40/80/127, plucks at 0.35 and 0.20 m; {:.1} s \
+         each, against the reference render of the same pluck; measures defined in \
+         `core/src/analysis/listening.rs`), worst / median over the grid:\n\n\
          | tier | sustained pitch (0.3–1.5 s), cents | glide (first 0.3 s), cents | 1/6-octave band levels to 16 kHz, dB RMS | centroid course | worst pitch at | worst bands at |\n\
          |---|---|---|---|---|---|---|\n",
         grid.len(),

@@ -11,8 +11,12 @@ use crate::tanpura::excitation::Pluck;
 use crate::tanpura::quality::Quality;
 use crate::tanpura::VoiceSettings;
 
-/// Keys from C2 to E4, every third semitone and the top key.
-pub const KEYS: [u8; 11] = [36, 39, 42, 45, 48, 51, 54, 57, 60, 63, 64];
+/// Keys from C2 to E4: every third semitone and the top key, and every crest key
+/// ([`CREST_KEYS`]), where the string at rest lies at the edge of the bridge's crest and a hard
+/// pluck may or may not lift it off: at key 53, between two keys of every third semitone, the
+/// fine tier's hardest pluck sounded 10 cents from the reference's (stop 57,
+/// `core/tests/tanpura_as_played.rs`), where the keys beside it agreed within a cent.
+pub const KEYS: [u8; 15] = [36, 39, 42, 45, 48, 49, 50, 51, 52, 53, 54, 57, 60, 63, 64];
 /// MIDI velocities, from the softest to the hardest.
 pub const VELOCITIES: [u8; 4] = [1, 40, 80, 127];
 /// Pluck positions, m from the tuning bead: the instrument's default and one nearer the bridge.
@@ -168,6 +172,7 @@ mod tests {
         assert_eq!(KEYS[0], 36);
         assert_eq!(*KEYS.last().unwrap(), 64);
         assert!(KEYS.windows(2).all(|pair| pair[1] - pair[0] <= 3));
+        assert!(CREST_KEYS.into_iter().all(|key| KEYS.contains(&key)));
     }
 
     #[test]
