@@ -264,6 +264,38 @@ fn a_string_bistable_between_agreeing_ends_gets_its_jawari_set() {
     );
 }
 
+/// A string of `settings` at `key` calibrated as played, at the studio tier and at the reference
+/// (on two threads): each tier's thread move and its sustained pitches at `velocities`, cents
+/// from the note.
+fn studio_and_reference_as_played(
+    settings: &EngineSettings,
+    key: u8,
+    velocities: [u8; 2],
+) -> [(f64, [f64; 2]); 2] {
+    let target = settings.tuning.note_hz(key);
+    let heard = |quality: Quality| {
+        let mut settings = *settings;
+        settings.voice.quality = quality;
+        let calibration = calibrate(&settings, &[key])[0];
+        let mut engine = Engine::new(&settings, SAMPLE_RATE, 1);
+        engine.set_calibration(&calibration);
+        let pitches = velocities.map(|velocity| {
+            engine.reset();
+            let signal = render(&mut engine, key, f32::from(velocity) / 127.0);
+            cents(sustained_pitch_hz(&signal, SAMPLE_RATE, target), target)
+        });
+        (calibration.thread_offset_m, pitches)
+    };
+    std::thread::scope(|scope| {
+        let studio = scope.spawn(|| heard(Quality::Studio));
+        let reference = heard(Quality::Reference);
+        [
+            studio.join().expect("the studio's calibration panicked"),
+            reference,
+        ]
+    })
+}
+
 /// One jawari for the instrument (issue 15; `as_played.rs`, *One jawari for the instrument*):
 /// the studio tier's string rests where the reference's rests, and its calibration takes the
 /// reference's thread move. Set on its own scheme, the studio's jawari for key 54 plucked at
@@ -273,29 +305,7 @@ fn a_string_bistable_between_agreeing_ends_gets_its_jawari_set() {
 fn the_studio_plays_the_jawari_the_reference_sets() {
     let mut settings = settings();
     settings.pluck.position_m = 0.20;
-    let key = 54u8;
-    let target = settings.tuning.note_hz(key);
-    let heard = |quality: Quality| {
-        let mut settings = settings;
-        settings.voice.quality = quality;
-        let calibration = calibrate(&settings, &[key])[0];
-        let mut engine = Engine::new(&settings, SAMPLE_RATE, 1);
-        engine.set_calibration(&calibration);
-        let pitches = [1u8, 127].map(|velocity| {
-            engine.reset();
-            let signal = render(&mut engine, key, f32::from(velocity) / 127.0);
-            cents(sustained_pitch_hz(&signal, SAMPLE_RATE, target), target)
-        });
-        (calibration.thread_offset_m, pitches)
-    };
-    let (studio, reference) = std::thread::scope(|scope| {
-        let studio = scope.spawn(|| heard(Quality::Studio));
-        let reference = heard(Quality::Reference);
-        (
-            studio.join().expect("the studio's calibration panicked"),
-            reference,
-        )
-    });
+    let [studio, reference] = studio_and_reference_as_played(&settings, 54, [1, 127]);
     assert!(
         reference.0 != 0.0,
         "the reference's jawari was not set: the case this test is about is gone"
@@ -325,29 +335,9 @@ fn the_studio_plays_the_jawari_the_reference_sets() {
 /// time step again (`docs/modal-tanpura.md` §13).
 #[test]
 fn at_a_bistable_key_the_studio_plays_the_references_hard_plucks() {
-    let settings = settings();
     let key = 53u8;
-    let target = settings.tuning.note_hz(key);
-    let heard = |quality: Quality| {
-        let mut settings = settings;
-        settings.voice.quality = quality;
-        let calibration = calibrate(&settings, &[key])[0];
-        let mut engine = Engine::new(&settings, SAMPLE_RATE, 1);
-        engine.set_calibration(&calibration);
-        [110u8, 127].map(|velocity| {
-            engine.reset();
-            let signal = render(&mut engine, key, f32::from(velocity) / 127.0);
-            cents(sustained_pitch_hz(&signal, SAMPLE_RATE, target), target)
-        })
-    };
-    let (studio, reference) = std::thread::scope(|scope| {
-        let studio = scope.spawn(|| heard(Quality::Studio));
-        let reference = heard(Quality::Reference);
-        (
-            studio.join().expect("the studio's calibration panicked"),
-            reference,
-        )
-    });
+    let [(_, studio), (_, reference)] =
+        studio_and_reference_as_played(&settings(), key, [110, 127]);
     println!(
         "key {key} at velocities 110 and 127: studio {studio:.2?}, reference {reference:.2?} cents"
     );
