@@ -86,8 +86,6 @@ pub struct FdTier {
     pub oversample: usize,
     /// N, string grid intervals over the 668 mm string.
     pub intervals: usize,
-    /// Barrier grid spacings relative to the seed's (0.18 mm bridge, 0.15 mm thread).
-    pub barrier_spacing_scale: f64,
     pub newton: NewtonSettings,
     pub solver: SolverKind,
 }
@@ -165,7 +163,6 @@ impl Quality {
             Quality::Reference => Tier::FiniteDifference(FdTier {
                 oversample: 4,
                 intervals: 200,
-                barrier_spacing_scale: 1.0,
                 newton: NewtonSettings::REFERENCE,
                 solver: SolverKind::Condensed,
             }),
@@ -237,7 +234,12 @@ mod tests {
         let tier = Quality::Reference.fd_tier().unwrap();
         assert_eq!(tier.oversample, 4);
         assert_eq!(tier.intervals, 200);
-        assert_eq!(tier.barrier_spacing_scale, 1.0);
+        // The seed's barrier grids: 0.18 mm on the bridge, 0.15 mm on the thread.
+        let config = crate::tanpura::VoiceSettings::default()
+            .fd_config_at(Quality::Reference, 44_100.0)
+            .unwrap();
+        assert_eq!(config.bridge.spacing_m, 0.18e-3);
+        assert_eq!(config.thread.unwrap().spacing_m, 0.15e-3);
         assert_eq!(tier.newton, NewtonSettings::REFERENCE);
     }
 

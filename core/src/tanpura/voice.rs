@@ -227,12 +227,10 @@ impl VoiceSettings {
         let mut config = FdStringConfig::REFERENCE;
         config.intervals = tier.intervals;
         config.time_step_s = 1.0 / (output_sample_rate_hz * tier.oversample as f64);
-        config.bridge.spacing_m *= tier.barrier_spacing_scale;
         config.bridge.stiffness_n_m2 = self.bridge_stiffness_n_m2;
         config.bridge.beyond_thread = self.bridge_beyond_thread;
         config.thread = self.thread_enabled.then_some(ThreadSettings {
             position_m: self.thread_position_m,
-            spacing_m: ThreadSettings::SEED.spacing_m * tier.barrier_spacing_scale,
             ..ThreadSettings::SEED
         });
         config.string = self.string_parameters(config.speaking_start_m());
