@@ -35,7 +35,8 @@ use javari_core::engine::midi_file::{self, format_time, MidiScore};
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::preset::{Preset, QUALITY_NAMES};
 use javari_core::engine::render::{
-    calibration_requests, render_blocks_calibrated, rendered_length, RenderOptions, Score,
+    calibration_need_samples, calibration_requests, render_blocks_scheduled, rendered_length,
+    RenderOptions, Score,
 };
 use javari_core::engine::wav::read_wav;
 use javari_core::engine::{EngineSettings, Instrument, VoiceRunner, VoiceTask};
@@ -204,17 +205,16 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     } else {
         CalibrationCache::for_workspace()
     };
-    let calibrations = calibrate(jobs, &settings, &score, sample_rate_hz, cache.as_ref())?;
     let mut progress = Progress::new(total, sample_rate_hz);
     let mut wav = PendingWav::create(&out, sample_rate_hz, channels)?;
     let mut peak = 0.0f32;
     let mut written = 0usize;
-    render_on(
+    let tuned = render_on(
         jobs,
         &settings,
-        &calibrations,
         &score,
         &options,
+        cache.as_ref(),
         &mut |block| {
             peak = block.iter().fold(peak, |peak, x| peak.max(x.abs()));
             written += block.len() / channels;
@@ -223,6 +223,9 @@ pub fn run(args: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         },
     )?;
     progress.finish();
+    if let Some(summary) = tuning_summary(&tuned, jobs) {
+        eprintln!("{summary}");
+    }
     if peak == 0.0 {
         return Err(format!(
             "{source}: the render is silent from start to end ({:.1} s), so no file is written; \
@@ -572,71 +575,125 @@ fn progress_line(
     ))
 }
 
-/// [`render_blocks_calibrated`] with the voices of each segment on `jobs` threads (rayon); one
-/// job renders on this thread exactly as the plugin does. The voices' outputs are summed in a
-/// fixed order ([`javari_core::engine::Engine::process_with`]), so the signal does not depend on
-/// `jobs`.
+/// One string's as-played calibration as a render took it: where it came from and how long it
+/// took to read or measure.
+#[derive(Debug, Clone, Copy)]
+struct Tuned {
+    calibration: Calibration,
+    source: Source,
+    seconds: f64,
+}
+
+/// Renders `score` with every string it plucks tuned by its sustained pitch as played
+/// (`javari_core::tanpura::as_played`), the voices of each segment on `jobs` threads (rayon);
+/// one job renders on this thread exactly as the plugin does. The voices' outputs are summed in
+/// a fixed order ([`javari_core::engine::Engine::process_with`]), so the signal does not depend
+/// on `jobs`.
+///
+/// Each string's calibration is read from `cache` when an earlier run kept it, else measured and
+/// kept, and handed to the engine just before the block that first plucks the string
+/// ([`render_blocks_scheduled`], [`calibration_need_samples`]), whatever `jobs` is. With one job
+/// it is measured there; with more, every calibration is measured on the same threads as the
+/// voices, the strings plucked first queued first, so that the render of the first notes
+/// proceeds while the later strings are measured and waits only for a string it is about to
+/// pluck. Returns the calibrations taken, in the order of [`calibration_requests`].
 fn render_on(
     jobs: usize,
     settings: &EngineSettings,
-    calibrations: &[Calibration],
     score: &Score,
     options: &RenderOptions,
+    cache: Option<&CalibrationCache>,
     emit: &mut (dyn FnMut(&[f32]) -> Result<(), String> + Send),
-) -> Result<(), String> {
+) -> Result<Vec<Tuned>, String> {
+    let requests = calibration_requests(settings, score);
+    let needed_at = calibration_need_samples(settings, score, options.sample_rate_hz, &requests);
+    let measure = |index: usize| {
+        let started = Instant::now();
+        let (calibration, source) = calibration(cache, &requests[index], options.sample_rate_hz);
+        Tuned {
+            calibration,
+            source,
+            seconds: started.elapsed().as_secs_f64(),
+        }
+    };
+    let mut tuned: Vec<Option<Tuned>> = vec![None; requests.len()];
     if jobs <= 1 {
-        return render_blocks_calibrated(settings, calibrations, score, options, None, emit);
+        let mut take = |index: usize| {
+            let measured = measure(index);
+            tuned[index] = Some(measured);
+            measured.calibration
+        };
+        render_blocks_scheduled(settings, &needed_at, &mut take, score, options, None, emit)?;
+        return Ok(tuned.into_iter().flatten().collect());
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
         .build()
         .map_err(|error| format!("cannot start {jobs} threads: {error}"))?;
-    // The whole render runs inside the pool, so that handing out a segment's voices is a cheap
-    // fork-join among its threads.
-    pool.install(|| {
-        let runner = |tasks: &mut [VoiceTask<'_>]| tasks.par_iter_mut().for_each(VoiceTask::run);
+    let mut queue: Vec<usize> = (0..requests.len()).collect();
+    queue.sort_by_key(|&index| (needed_at[index], index));
+    let rendered = pool.in_place_scope(|scope| {
+        let (sender, receiver) = std::sync::mpsc::channel();
+        // Spawned from outside the pool, the jobs are taken in the order they are queued.
+        for &index in &queue {
+            let sender = sender.clone();
+            let measure = &measure;
+            scope.spawn(move |_| {
+                // The receiver outlives every job: it is dropped after the last is received.
+                let _ = sender.send((index, measure(index)));
+            });
+        }
+        drop(sender);
+        let mut take = |index: usize| loop {
+            if let Some(measured) = tuned[index] {
+                return measured.calibration;
+            }
+            let (done, measured) = receiver
+                .recv()
+                .expect("every calibration job sends its result before it ends");
+            tuned[done] = Some(measured);
+        };
+        // A segment's voices go to the pool from this thread, behind the calibrations queued
+        // before them.
+        let runner = |tasks: &mut [VoiceTask<'_>]| {
+            pool.install(|| tasks.par_iter_mut().for_each(VoiceTask::run));
+        };
         let runner: VoiceRunner<'_> = &runner;
-        render_blocks_calibrated(settings, calibrations, score, options, Some(runner), emit)
-    })
+        let rendered = render_blocks_scheduled(
+            settings,
+            &needed_at,
+            &mut take,
+            score,
+            options,
+            Some(runner),
+            emit,
+        );
+        // The strings the render ended before plucking are measured and kept all the same.
+        for (done, measured) in receiver {
+            tuned[done] = Some(measured);
+        }
+        rendered
+    });
+    rendered?;
+    Ok(tuned.into_iter().flatten().collect())
 }
 
-/// Tunes every string the score plucks by its sustained pitch as played
-/// (`javari_core::tanpura::as_played`): each string's calibration is read from `cache` when an
-/// earlier run kept it, else measured on `jobs` threads (rayon) and kept; announced with the
-/// time it took. None when the preset turns the as-played tuning off.
-fn calibrate(
-    jobs: usize,
-    settings: &EngineSettings,
-    score: &Score,
-    sample_rate_hz: f64,
-    cache: Option<&CalibrationCache>,
-) -> Result<Vec<Calibration>, String> {
-    let requests = calibration_requests(settings, score);
-    if requests.is_empty() {
-        return Ok(Vec::new());
+/// What the render's as-played tuning did, for the log: none when no string was tuned.
+fn tuning_summary(tuned: &[Tuned], jobs: usize) -> Option<String> {
+    if tuned.is_empty() {
+        return None;
     }
-    let started = Instant::now();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs.max(1))
-        .build()
-        .map_err(|error| format!("cannot start {jobs} threads: {error}"))?;
-    let (calibrations, sources): (Vec<Calibration>, Vec<Source>) = pool.install(|| {
-        requests
-            .par_iter()
-            .map(|request| calibration(cache, request, sample_rate_hz))
-            .unzip()
-    });
-    let cached = sources
+    let cached = tuned
         .iter()
-        .filter(|&&source| source == Source::Cached)
+        .filter(|tuned| tuned.source == Source::Cached)
         .count();
-    let largest = calibrations
+    let largest = tuned
         .iter()
-        .map(|calibration| calibration.offset_cents.abs())
+        .map(|tuned| tuned.calibration.offset_cents.abs())
         .fold(0.0, f64::max);
-    let moved: Vec<f64> = calibrations
+    let moved: Vec<f64> = tuned
         .iter()
-        .map(|calibration| calibration.thread_offset_m)
+        .map(|tuned| tuned.calibration.thread_offset_m)
         .filter(|&offset| offset != 0.0)
         .collect();
     let threads = if moved.is_empty() {
@@ -651,7 +708,7 @@ fn calibrate(
     };
     let kept = match cached {
         0 => String::new(),
-        n if n == calibrations.len() => {
+        n if n == tuned.len() => {
             "; every calibration read from target/calibration-cache, measured by an earlier run"
                 .to_string()
         }
@@ -660,14 +717,19 @@ fn calibrate(
              earlier run"
         ),
     };
-    eprintln!(
-        "tuned {} string{} by their sustained pitch as played in {:.1} s (largest offset from \
-         the linearised tuning {largest:.1} cents{threads}{kept})",
-        calibrations.len(),
-        if calibrations.len() == 1 { "" } else { "s" },
-        started.elapsed().as_secs_f64()
-    );
-    Ok(calibrations)
+    let seconds: f64 = tuned.iter().map(|tuned| tuned.seconds).sum();
+    let alongside = if jobs > 1 {
+        ", alongside the render"
+    } else {
+        ""
+    };
+    Some(format!(
+        "tuned {} string{} by their sustained pitch as played ({seconds:.1} s of calibration \
+         summed over the strings{alongside}; largest offset from the linearised tuning {largest:.1} \
+         cents{threads}{kept})",
+        tuned.len(),
+        if tuned.len() == 1 { "" } else { "s" },
+    ))
 }
 
 /// Frame length and hop of the spectrogram, samples.
@@ -814,10 +876,29 @@ fn warn_if_bowed_preset_is_unstable(settings: &EngineSettings, score: &Score) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use javari_core::engine::render::render_blocks_calibrated;
+
+    /// The samples of `render_on` with `jobs` threads, and the calibrations it took.
+    fn rendered_bits(
+        jobs: usize,
+        settings: &EngineSettings,
+        score: &Score,
+        options: &RenderOptions,
+        cache: Option<&CalibrationCache>,
+    ) -> (Vec<u32>, Vec<Calibration>) {
+        let mut bits = Vec::new();
+        let tuned = render_on(jobs, settings, score, options, cache, &mut |block| {
+            bits.extend(block.iter().map(|x| x.to_bits()));
+            Ok(())
+        })
+        .unwrap();
+        (bits, tuned.iter().map(|tuned| tuned.calibration).collect())
+    }
 
     #[test]
     fn every_number_of_jobs_renders_the_same_bits() {
-        // Overlapping notes on several strings, so that several voices share each segment.
+        // Overlapping notes on several strings, so that several voices share each segment; the
+        // later strings are measured while the first ones render.
         let mut score = Score::default();
         for (index, note) in [43u8, 48, 52, 55, 36, 60].into_iter().enumerate() {
             score.note(0.02 * index as f64, 0.2, note, 0.9);
@@ -829,30 +910,32 @@ mod tests {
             block_size: 256,
             ..RenderOptions::default()
         };
-        // Tuned as played, as `render` does.
-        let calibrations = calibrate(2, &settings, &score, options.sample_rate_hz, None).unwrap();
-        assert!(!calibrations.is_empty());
-        let bits = |jobs| {
-            let mut bits = Vec::new();
-            render_on(
-                jobs,
-                &settings,
-                &calibrations,
-                &score,
-                &options,
-                &mut |block| {
-                    bits.extend(block.iter().map(|x| x.to_bits()));
-                    Ok(())
-                },
-            )
-            .unwrap();
-            bits
-        };
-        let one = bits(1);
+        let (one, calibrations) = rendered_bits(1, &settings, &score, &options, None);
+        assert_eq!(calibrations.len(), 6, "every string tuned as played");
         assert!(one.iter().any(|&x| f32::from_bits(x) != 0.0));
         for jobs in [2, 3, 8] {
-            assert!(one == bits(jobs), "{jobs} jobs differ from one");
+            let (bits, taken) = rendered_bits(jobs, &settings, &score, &options, None);
+            assert!(one == bits, "{jobs} jobs differ from one");
+            assert_eq!(taken, calibrations);
         }
+        // The same samples as with every calibration given before the first block.
+        let mut up_front = Vec::new();
+        render_blocks_calibrated(
+            &settings,
+            &calibrations,
+            &score,
+            &options,
+            None,
+            &mut |block| {
+                up_front.extend(block.iter().map(|x| x.to_bits()));
+                Ok::<(), String>(())
+            },
+        )
+        .unwrap();
+        assert!(
+            one == up_front,
+            "a calibration handed over late changed the render"
+        );
     }
 
     /// A render keeps the calibrations it measured, exactly, and a second render of the same
@@ -865,10 +948,15 @@ mod tests {
         }
         let mut settings = EngineSettings::default();
         settings.voice.quality = Quality::Draft;
+        let options = RenderOptions {
+            tail_s: 0.05,
+            ..RenderOptions::default()
+        };
         let directory = tempfile::tempdir().unwrap();
         let cache = CalibrationCache::at(directory.path().to_path_buf(), "test");
-        let fresh = calibrate(1, &settings, &score, 44_100.0, None).unwrap();
-        let first = calibrate(1, &settings, &score, 44_100.0, Some(&cache)).unwrap();
+        let calibrate = |jobs, cache| rendered_bits(jobs, &settings, &score, &options, cache).1;
+        let fresh = calibrate(1, None);
+        let first = calibrate(2, Some(&cache));
         assert_eq!(fresh.len(), 2);
         assert_eq!(first, fresh);
         for calibration in &first {
@@ -882,15 +970,12 @@ mod tests {
                 ..*calibration
             });
         }
-        let second = calibrate(1, &settings, &score, 44_100.0, Some(&cache)).unwrap();
+        let second = calibrate(1, Some(&cache));
         for (second, first) in second.iter().zip(&first) {
             assert_eq!(second.offset_cents, first.offset_cents + 1.0);
         }
         // Without the cache, measured again.
-        assert_eq!(
-            calibrate(1, &settings, &score, 44_100.0, None).unwrap(),
-            fresh
-        );
+        assert_eq!(calibrate(1, None), fresh);
     }
 
     /// A fresh directory for one test's files.

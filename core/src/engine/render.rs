@@ -194,6 +194,42 @@ pub fn calibration_requests(settings: &EngineSettings, score: &Score) -> Vec<Cal
     Engine::planned_strings(settings, &score.played_notes())
 }
 
+/// The sample from which each of `requests` (a score's [`calibration_requests`]) is needed: that
+/// of the first note-on whose strings ([`Engine::planned_strings`] of its note) include it; 0
+/// for every string of a drone on a fixed Sa, which plays from the start, and for a request no
+/// note-on plucks. A renderer may hand a calibration to [`render_blocks_scheduled`] as late as
+/// this and render the same samples as with every calibration given before the first block.
+pub fn calibration_need_samples(
+    settings: &EngineSettings,
+    score: &Score,
+    sample_rate_hz: f64,
+    requests: &[CalibrationRequest],
+) -> Vec<usize> {
+    let clamped = settings.clamped();
+    let fixed_sa = clamped.drone.enabled && clamped.drone.sa_note.is_some();
+    let mut needed_at: Vec<Option<usize>> = vec![fixed_sa.then_some(0); requests.len()];
+    for event in &score.events {
+        let ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }) = event.action else {
+            continue;
+        };
+        if velocity <= 0.0 {
+            continue;
+        }
+        let at = time_to_sample(event.time_s, sample_rate_hz);
+        for string in Engine::planned_strings(settings, &[note]) {
+            for (request, needed) in requests.iter().zip(needed_at.iter_mut()) {
+                if *request == string && needed.is_none() {
+                    *needed = Some(at);
+                }
+            }
+        }
+    }
+    needed_at
+        .into_iter()
+        .map(|needed| needed.unwrap_or(0))
+        .collect()
+}
+
 /// [`render_blocks`] with the strings tuned as played by `calibrations` (see
 /// [`calibration_requests`]); strings without one keep their linearised tuning.
 pub fn render_blocks_calibrated<E>(
@@ -204,10 +240,39 @@ pub fn render_blocks_calibrated<E>(
     runner: Option<VoiceRunner<'_>>,
     emit: &mut dyn FnMut(&[f32]) -> Result<(), E>,
 ) -> Result<(), E> {
+    let up_front = vec![0; calibrations.len()];
+    render_blocks_scheduled(
+        settings,
+        &up_front,
+        &mut |index| calibrations[index],
+        score,
+        options,
+        runner,
+        emit,
+    )
+}
+
+/// [`render_blocks_calibrated`] with calibration `i` taken from `calibration(i)` just before the
+/// block that holds sample `needed_at[i]` ([`calibration_need_samples`]), in the order of those
+/// samples (ties by index), so that a renderer can measure the strings a score plucks later
+/// while it renders the first. `calibration` may wait for its calibration to be measured; it is
+/// called once for each index, and not at all for one needed after the render's end. The
+/// samples depend on the schedule only through the engine's table of calibrations: they are
+/// those of every calibration given up front whenever the table holds them all
+/// ([`crate::tanpura::as_played::AS_PLAYED_CAPACITY`] strings).
+pub fn render_blocks_scheduled<E>(
+    settings: &EngineSettings,
+    needed_at: &[usize],
+    calibration: &mut dyn FnMut(usize) -> Calibration,
+    score: &Score,
+    options: &RenderOptions,
+    runner: Option<VoiceRunner<'_>>,
+    emit: &mut dyn FnMut(&[f32]) -> Result<(), E>,
+) -> Result<(), E> {
     let mut engine = Engine::new(settings, options.sample_rate_hz, options.voice_count);
-    for calibration in calibrations {
-        engine.set_calibration(calibration);
-    }
+    let mut schedule: Vec<usize> = (0..needed_at.len()).collect();
+    schedule.sort_by_key(|&index| (needed_at[index], index));
+    let mut next_calibration = 0;
     let total = rendered_length(score, options);
     let block_size = options.block_size.max(1);
     let mut output = vec![0.0f32; block_size];
@@ -234,6 +299,13 @@ pub fn render_blocks_calibrated<E>(
                 break;
             }
             engine_events += usize::from(!is_tempo);
+        }
+        while let Some(&index) = schedule.get(next_calibration) {
+            if needed_at[index] >= end {
+                break;
+            }
+            engine.set_calibration(&calibration(index));
+            next_calibration += 1;
         }
         block_events.clear();
         while let Some(event) = score.events.get(next_event) {
@@ -401,5 +473,31 @@ mod tests {
         let demo = Score::demo();
         assert_eq!(demo.end_s, 11.5);
         assert_eq!(demo.events.len(), 22);
+    }
+
+    /// Each string of the demo is needed from its first note-on (the arpeggio's E3 and G3 only
+    /// from 10.25 and 10.5 s, so a renderer measures them while it renders the drone), and every
+    /// string of a drone on a fixed Sa from the start.
+    #[test]
+    fn a_string_is_needed_from_the_first_note_on_that_plucks_it() {
+        let settings = EngineSettings::default();
+        let demo = Score::demo();
+        let requests = calibration_requests(&settings, &demo);
+        let notes: Vec<f64> = requests
+            .iter()
+            .map(|request| request.settings.fundamental_hz)
+            .collect();
+        let expected_hz = [43u8, 48, 36, 52, 55].map(|note| settings.tuning.note_hz(note));
+        assert_eq!(notes, expected_hz);
+        let needed_at = calibration_need_samples(&settings, &demo, 44_100.0, &requests);
+        assert_eq!(needed_at, [0, 44_100, 132_300, 452_025, 463_050]);
+        let mut drone = settings;
+        drone.drone.enabled = true;
+        drone.drone.sa_note = Some(50);
+        let requests = calibration_requests(&drone, &demo);
+        // Pa, the two Sa strings (one pitch) and low Sa.
+        assert_eq!(requests.len(), 3);
+        let needed_at = calibration_need_samples(&drone, &demo, 44_100.0, &requests);
+        assert!(needed_at.iter().all(|&sample| sample == 0));
     }
 }

@@ -69,9 +69,12 @@
 //!
 //! The first pass costs two renders of [`CALIBRATION_SECONDS`] on the string's tier, the second
 //! three, each thread move tried two more and the one kept three more again, so a calibration
-//! is an offline job (the renderer before it renders, a background thread in the plugin), never
-//! the audio thread's. The studio's costs the reference's calibration and four renders of its
-//! own.
+//! is an offline job (the renderer's, alongside its render and before the string's first
+//! pluck; a background thread's in the plugin), never the audio thread's. The studio's costs the
+//! reference's calibration and four renders of its own. The first pass cannot be taken on a
+//! cheaper tier: the second pass's plucks at the offset it finds are what tells a bistable string
+//! (the reference's key 54 plucked at 0.20 m), and from the fine tier's first pass that string
+//! keeps its thread unmoved (`docs/performance.md`, stop 58).
 //! The result is a plain number of cents and a thread move per string, which the engine adds to
 //! the string's target and thread position ([`AsPlayedTuning`]).
 
