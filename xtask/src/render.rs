@@ -44,6 +44,7 @@ use javari_core::tanpura::as_played::Calibration;
 use javari_core::tanpura::quality::Quality;
 use rayon::prelude::*;
 use std::io::{BufWriter, IsTerminal};
+use std::panic::AssertUnwindSafe;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -89,8 +90,9 @@ pub struct RenderArgs {
     /// output is radiated): power averaged over the whole render, dB re its peak, to 16 kHz.
     #[arg(long, value_name = "FILE.png")]
     spectrum: Option<PathBuf>,
-    /// Threads that run the voices (1 to 256; default: every core). The output is bit-identical
-    /// for any number.
+    /// Threads that measure the strings' calibrations and run the voices (1 to 256; default: every
+    /// core), besides the one that drives the render when more than one. The output is
+    /// bit-identical for any number.
     #[arg(long, value_name = "N", value_parser = number_in(1usize, 256))]
     jobs: Option<usize>,
     /// Longest render allowed, s (1 to 86400; default one hour): a score whose rendered length
@@ -585,18 +587,25 @@ struct Tuned {
 }
 
 /// Renders `score` with every string it plucks tuned by its sustained pitch as played
-/// (`javari_core::tanpura::as_played`), the voices of each segment on `jobs` threads (rayon);
-/// one job renders on this thread exactly as the plugin does. The voices' outputs are summed in
-/// a fixed order ([`javari_core::engine::Engine::process_with`]), so the signal does not depend
-/// on `jobs`.
+/// (`javari_core::tanpura::as_played`), the voices of each segment on a rayon pool; one job
+/// renders on this thread exactly as the plugin does. The voices' outputs are summed in a fixed
+/// order ([`javari_core::engine::Engine::process_with`]), so the signal does not depend on
+/// `jobs`.
 ///
 /// Each string's calibration is read from `cache` when an earlier run kept it, else measured and
 /// kept, and handed to the engine just before the block that first plucks the string
 /// ([`render_blocks_scheduled`], [`calibration_need_samples`]), whatever `jobs` is. With one job
-/// it is measured there; with more, every calibration is measured on the same threads as the
-/// voices, the strings plucked first queued first, so that the render of the first notes
-/// proceeds while the later strings are measured and waits only for a string it is about to
-/// pluck. Returns the calibrations taken, in the order of [`calibration_requests`].
+/// it is measured there. With `jobs` > 1 the pool has `jobs` threads for the calibrations and the
+/// voices and one more, which drives the render: it hands out each segment's voices and takes
+/// some of them, and when a string it is about to pluck is still being measured it waits, taking
+/// no calibration itself, so that it resumes as soon as that one is done. The calibrations are
+/// queued in the order their strings are first plucked, so the render of the first notes
+/// proceeds while the later strings are measured. (Stop 58 measured three ways on two cores: the
+/// render on a thread outside the pool paid a pool hand-over per block, 0.81 s against 0.44 s
+/// for the demo at the live tier; a render thread that measured queued strings while it waited
+/// was stuck in a long one while the render could have gone on, 12.9 s against 11.7-12.4 s for
+/// the studio's first render.) Returns the calibrations taken, in the order of
+/// [`calibration_requests`].
 fn render_on(
     jobs: usize,
     settings: &EngineSettings,
@@ -627,53 +636,61 @@ fn render_on(
         return Ok(tuned.into_iter().flatten().collect());
     }
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs)
+        .num_threads(jobs + 1)
         .build()
-        .map_err(|error| format!("cannot start {jobs} threads: {error}"))?;
+        .map_err(|error| format!("cannot start {} threads: {error}", jobs + 1))?;
     let mut queue: Vec<usize> = (0..requests.len()).collect();
     queue.sort_by_key(|&index| (needed_at[index], index));
-    let rendered = pool.in_place_scope(|scope| {
-        let (sender, receiver) = std::sync::mpsc::channel();
-        // Spawned from outside the pool, the jobs are taken in the order they are queued.
-        for &index in &queue {
-            let sender = sender.clone();
-            let measure = &measure;
-            scope.spawn(move |_| {
-                // The receiver outlives every job: it is dropped after the last is received.
-                let _ = sender.send((index, measure(index)));
-            });
-        }
-        drop(sender);
-        let mut take = |index: usize| loop {
-            if let Some(measured) = tuned[index] {
-                return measured.calibration;
+    let (sender, receiver) = crossbeam::channel::unbounded();
+    // The whole render runs inside the pool, so that handing out a segment's voices is a cheap
+    // fork-join among its threads.
+    let rendered = pool.install(|| {
+        rayon::scope_fifo(|scope| {
+            // First in, first out, for this thread and for the threads that steal them.
+            for &index in &queue {
+                let sender = sender.clone();
+                let measure = &measure;
+                scope.spawn_fifo(move |_| {
+                    // Sent even if the measurement panics, so that the render never waits for a
+                    // string that will not come; the scope then passes the panic on.
+                    let measured = std::panic::catch_unwind(AssertUnwindSafe(|| measure(index)));
+                    // The receiver outlives every job.
+                    let _ = sender.send((index, measured.as_ref().ok().copied()));
+                    if let Err(panic) = measured {
+                        std::panic::resume_unwind(panic);
+                    }
+                });
             }
-            let (done, measured) = receiver
-                .recv()
-                .expect("every calibration job sends its result before it ends");
-            tuned[done] = Some(measured);
-        };
-        // A segment's voices go to the pool from this thread, behind the calibrations queued
-        // before them.
-        let runner = |tasks: &mut [VoiceTask<'_>]| {
-            pool.install(|| tasks.par_iter_mut().for_each(VoiceTask::run));
-        };
-        let runner: VoiceRunner<'_> = &runner;
-        let rendered = render_blocks_scheduled(
-            settings,
-            &needed_at,
-            &mut take,
-            score,
-            options,
-            Some(runner),
-            emit,
-        );
-        // The strings the render ended before plucking are measured and kept all the same.
-        for (done, measured) in receiver {
-            tuned[done] = Some(measured);
-        }
-        rendered
+            let mut take = |index: usize| loop {
+                if let Some(measured) = tuned[index] {
+                    return measured.calibration;
+                }
+                let received = receiver.recv().expect("the sender outlives the render");
+                match received {
+                    (done, Some(measured)) => tuned[done] = Some(measured),
+                    (done, None) => panic!("measuring the calibration of string {done} panicked"),
+                }
+            };
+            let runner =
+                |tasks: &mut [VoiceTask<'_>]| tasks.par_iter_mut().for_each(VoiceTask::run);
+            let runner: VoiceRunner<'_> = &runner;
+            render_blocks_scheduled(
+                settings,
+                &needed_at,
+                &mut take,
+                score,
+                options,
+                Some(runner),
+                emit,
+            )
+        })
     });
+    // The scope has run every job, the strings the render ended before plucking too (measured
+    // and kept all the same).
+    drop(sender);
+    for (done, measured) in receiver.try_iter() {
+        tuned[done] = measured;
+    }
     rendered?;
     Ok(tuned.into_iter().flatten().collect())
 }
