@@ -46,6 +46,7 @@ use rayon::prelude::*;
 use std::io::{BufWriter, IsTerminal};
 use std::panic::AssertUnwindSafe;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 #[derive(Debug, Parser)]
@@ -642,6 +643,8 @@ fn render_on(
     let mut queue: Vec<usize> = (0..requests.len()).collect();
     queue.sort_by_key(|&index| (needed_at[index], index));
     let (sender, receiver) = crossbeam::channel::unbounded();
+    // Set when the render fails: the strings not yet started are then not measured.
+    let abandoned = AtomicBool::new(false);
     // The whole render runs inside the pool, so that handing out a segment's voices is a cheap
     // fork-join among its threads.
     let rendered = pool.install(|| {
@@ -649,8 +652,11 @@ fn render_on(
             // First in, first out, for this thread and for the threads that steal them.
             for &index in &queue {
                 let sender = sender.clone();
-                let measure = &measure;
+                let (measure, abandoned) = (&measure, &abandoned);
                 scope.spawn_fifo(move |_| {
+                    if abandoned.load(Ordering::Relaxed) {
+                        return;
+                    }
                     // Sent even if the measurement panics, so that the render never waits for a
                     // string that will not come; the scope then passes the panic on.
                     let measured = std::panic::catch_unwind(AssertUnwindSafe(|| measure(index)));
@@ -674,7 +680,7 @@ fn render_on(
             let runner =
                 |tasks: &mut [VoiceTask<'_>]| tasks.par_iter_mut().for_each(VoiceTask::run);
             let runner: VoiceRunner<'_> = &runner;
-            render_blocks_scheduled(
+            let rendered = render_blocks_scheduled(
                 settings,
                 &needed_at,
                 &mut take,
@@ -682,11 +688,13 @@ fn render_on(
                 options,
                 Some(runner),
                 emit,
-            )
+            );
+            abandoned.store(rendered.is_err(), Ordering::Relaxed);
+            rendered
         })
     });
-    // The scope has run every job, the strings the render ended before plucking too (measured
-    // and kept all the same).
+    // The scope has run every job: the strings the render ended before plucking are measured and
+    // kept all the same, unless the render failed.
     drop(sender);
     for (done, measured) in receiver.try_iter() {
         tuned[done] = measured;
@@ -952,6 +960,38 @@ mod tests {
         assert!(
             one == up_front,
             "a calibration handed over late changed the render"
+        );
+    }
+
+    /// A render that fails (here, its output cannot be written) returns the error and does not
+    /// go on measuring the strings it had queued for later.
+    #[test]
+    fn a_failed_render_stops_measuring_its_later_strings() {
+        let mut score = Score::default();
+        let notes = [36u8, 39, 42, 45, 48, 51, 54, 57, 60, 63];
+        for (index, note) in notes.into_iter().enumerate() {
+            score.note(1.0 + index as f64, 0.5, note, 0.8);
+        }
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = Quality::Draft;
+        let directory = tempfile::tempdir().unwrap();
+        let cache = CalibrationCache::at(directory.path().to_path_buf(), "test");
+        let options = RenderOptions::default();
+        let mut blocks = 0;
+        let failed = render_on(2, &settings, &score, &options, Some(&cache), &mut |_| {
+            blocks += 1;
+            if blocks * options.block_size > 44_100 + 2 * options.block_size {
+                Err("disk full".to_string())
+            } else {
+                Ok(())
+            }
+        });
+        assert_eq!(failed.unwrap_err(), "disk full");
+        let measured = std::fs::read_dir(directory.path()).unwrap().count();
+        assert!(
+            (1..notes.len()).contains(&measured),
+            "{measured} of {} strings measured",
+            notes.len()
         );
     }
 
