@@ -13,17 +13,24 @@
 //! the string at every key 36–64 on every tier, and the one-string targets are read at the
 //! slowest key as well as at the scene's own.
 //!
+//! The demo render is timed as a user meets it: `cargo xtask render`'s scene at its tier (the
+//! reference) on every core, first with every string's calibration measured, then with the
+//! calibrations read back ([`DemoRender`]).
+//!
 //! Writes a markdown table (`--markdown FILE`, default `bench.md`) and, with `--json FILE`, one
 //! JSON object. A benchmark, not a test: nothing here asserts on time.
 
 use crate::args::number_in;
+use crate::calibration_cache::CalibrationCache;
 use crate::playing_range::{self, TierOverGrid};
+use crate::render::render_on;
 use clap::Parser;
 use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz};
 use javari_core::analysis::refined::{refined_reference_pluck, RefinedRender};
 use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
 use javari_core::engine::pitch::note_to_hz;
+use javari_core::engine::render::{rendered_length, RenderOptions, Score};
 use javari_core::engine::{Engine, EngineEvent, EngineSettings, TanpuraOutput, TimedEvent};
 use javari_core::newton::NewtonStats;
 use javari_core::tanpura::excitation::Pluck;
@@ -790,6 +797,7 @@ pub fn targets_markdown(
     results: &[BenchResult],
     keys: &[KeySpeeds],
     grid: &[TierOverGrid],
+    demo: Option<&DemoRender>,
 ) -> String {
     let find = |voice: &str, tier: &str, scene: &str| {
         results
@@ -915,6 +923,21 @@ pub fn targets_markdown(
         "×",
     );
     line(
+        &format!(
+            "the demo (`cargo xtask render`, reference tier), first render{}: faster than real \
+             time",
+            demo.map_or(String::new(), |demo| format!(
+                " on {} thread{}",
+                demo.threads,
+                if demo.threads == 1 { "" } else { "s" }
+            ))
+        ),
+        demo.map(DemoRender::first_factor),
+        1.0,
+        true,
+        "×",
+    );
+    line(
         "bowed rounded-corner voice (body on): ≥ 1000× real time",
         find("bowed", "rounded-corner", "bowed-note").map(|r| r.realtime_factor),
         1000.0,
@@ -988,6 +1011,7 @@ pub fn to_json(
     grid: &[TierOverGrid],
     grid_against_refined: &[TierOverGrid],
     refinement: Option<&ReferenceRefinement>,
+    demo: Option<&DemoRender>,
 ) -> String {
     let rows: Vec<String> = results
         .iter()
@@ -1060,14 +1084,25 @@ pub fn to_json(
     format!(
         "{{\"machine\": \"{}\", \"results\": [\n  {}\n], \"economy\": [\n  {}\n], \
          \"speed_across_keys\": [\n  {}\n], \"playing_range\": [\n  {}\n], \
-         \"playing_range_against_refined\": [\n  {}\n], \"reference_refinement\": {}}}\n",
+         \"playing_range_against_refined\": [\n  {}\n], \"reference_refinement\": {}, \
+         \"demo_render\": {}}}\n",
         machine.replace('"', "'"),
         rows.join(",\n  "),
         economy_rows.join(",\n  "),
         key_rows.join(",\n  "),
         playing_range::to_json_rows(grid).join(",\n  "),
         playing_range::to_json_rows(grid_against_refined).join(",\n  "),
-        refinement
+        refinement,
+        demo.map_or("null".to_string(), |demo| format!(
+            "{{\"threads\": {}, \"audio_s\": {}, \"first_s\": {}, \"again_s\": {}, \
+             \"first_realtime_factor\": {}, \"again_realtime_factor\": {}}}",
+            demo.threads,
+            json_number(Some(demo.audio_s)),
+            json_number(Some(demo.first_s)),
+            json_number(Some(demo.again_s)),
+            json_number(Some(demo.first_factor())),
+            json_number(Some(demo.again_factor()))
+        ))
     )
 }
 
@@ -1117,6 +1152,88 @@ pub fn to_markdown(machine: &str, runs: u32, results: &[BenchResult]) -> String 
     text
 }
 
+/// `cargo xtask render` with no arguments (the demo scene, the reference tier, 512-sample
+/// blocks), timed on `threads` threads: its first render, which measures every string's
+/// calibration alongside the render, and the same render with the calibrations read back.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DemoRender {
+    pub threads: usize,
+    pub audio_s: f64,
+    pub first_s: f64,
+    pub again_s: f64,
+}
+
+impl DemoRender {
+    pub fn first_factor(&self) -> f64 {
+        self.audio_s / self.first_s
+    }
+
+    pub fn again_factor(&self) -> f64 {
+        self.audio_s / self.again_s
+    }
+}
+
+/// Times the demo render ([`DemoRender`]) on every core, its calibrations kept in a directory of
+/// their own for the second render; `None` if a render fails (said on stderr).
+fn run_demo_render() -> Option<DemoRender> {
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    let settings = EngineSettings::default();
+    let score = Score::demo();
+    let options = RenderOptions::default();
+    let directory = match tempfile::tempdir() {
+        Ok(directory) => directory,
+        Err(error) => {
+            eprintln!("bench: demo render: no directory for its calibrations: {error}");
+            return None;
+        }
+    };
+    let cache = CalibrationCache::at(directory.path().to_path_buf(), "bench");
+    let mut timed = |what: &str| {
+        eprintln!("bench: the demo render, {what} ...");
+        let started = Instant::now();
+        let rendered = render_on(
+            threads,
+            &settings,
+            &score,
+            &options,
+            Some(&cache),
+            &mut |_| Ok(()),
+        );
+        let seconds = started.elapsed().as_secs_f64();
+        match rendered {
+            Ok(_) => Some(seconds),
+            Err(error) => {
+                eprintln!("bench: demo render failed: {error}");
+                None
+            }
+        }
+    };
+    let first_s = timed("calibrations measured")?;
+    let again_s = timed("calibrations read back")?;
+    Some(DemoRender {
+        threads,
+        audio_s: rendered_length(&score, &options) as f64 / options.sample_rate_hz,
+        first_s,
+        again_s,
+    })
+}
+
+/// The markdown of [`DemoRender`].
+pub fn demo_render_markdown(demo: &DemoRender) -> String {
+    format!(
+        "\nThe demo render (`cargo xtask render`: {:.1} s of audio, reference tier, {} thread{}): \
+         first render, every string's calibration measured alongside it, {:.2} s ({:.2}× real \
+         time); again, the calibrations read back, {:.2} s ({:.2}×).\n",
+        demo.audio_s,
+        demo.threads,
+        if demo.threads == 1 { "" } else { "s" },
+        demo.first_s,
+        demo.first_factor(),
+        demo.again_s,
+        demo.again_factor()
+    )
+}
+
 pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     let BenchArgs {
         seconds,
@@ -1148,6 +1265,7 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
             run_key_speeds(seconds, runs),
         )
     };
+    let demo = if grid_only { None } else { run_demo_render() };
     let refinement = run_reference_refinement(&results, seconds);
     let (grid, grid_against_refined) = if no_grid {
         (Vec::new(), Vec::new())
@@ -1175,7 +1293,10 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     if !keys.is_empty() {
         table += &key_speeds_markdown(&keys);
     }
-    table += &targets_markdown(&results, &keys, &grid);
+    if let Some(demo) = &demo {
+        table += &demo_render_markdown(demo);
+    }
+    table += &targets_markdown(&results, &keys, &grid, demo.as_ref());
     if let Some(refinement) = &refinement {
         table += &refinement_markdown(refinement);
     }
@@ -1196,6 +1317,7 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
                 &grid,
                 &grid_against_refined,
                 refinement.as_ref(),
+                demo.as_ref(),
             ),
         )
         .map_err(|error| format!("cannot write `{}`: {error}", path.display()))?;
@@ -1232,15 +1354,50 @@ mod tests {
         };
         assert_eq!(live.slowest(), Some((60, 88.0)));
         assert_eq!(live.median_factor(), 104.0);
-        let targets = targets_markdown(&[], std::slice::from_ref(&live), &[]);
+        let targets = targets_markdown(&[], std::slice::from_ref(&live), &[], None);
         assert!(targets.contains(
             "| live tier, one string at its slowest key of 36–64 (key 60): ≥ 100× real time \
              | 88.00× | missed: 1.1× short |"
         ));
         let table = key_speeds_markdown(std::slice::from_ref(&live));
         assert!(table.contains("| live | 88.00× (key 60) | 104.00× | 150.00× (key 36) |"));
-        let json = to_json("machine", &[], &[], &[live], &[], &[], None);
+        let json = to_json("machine", &[], &[], &[live], &[], &[], None, None);
         assert!(json.contains("{\"tier\": \"live\", \"key\": 60, \"realtime_factor\": 88.000000}"));
+    }
+
+    /// The demo's first render is a target (issue 10: faster than real time), reported with
+    /// its thread count, beside the render with its calibrations read back.
+    #[test]
+    fn the_demo_render_is_reported_against_real_time() {
+        let demo = DemoRender {
+            threads: 2,
+            audio_s: 14.5,
+            first_s: 14.0,
+            again_s: 8.0,
+        };
+        let targets = targets_markdown(&[], &[], &[], Some(&demo));
+        assert!(targets.contains(
+            "| the demo (`cargo xtask render`, reference tier), first render on 2 threads: \
+             faster than real time | 1.04× | met |"
+        ));
+        let slow = DemoRender {
+            first_s: 29.0,
+            ..demo
+        };
+        let targets = targets_markdown(&[], &[], &[], Some(&slow));
+        assert!(
+            targets.contains("| 0.50× | missed: 2.0× short |"),
+            "{targets}"
+        );
+        let table = demo_render_markdown(&demo);
+        assert!(table.contains("14.00 s (1.04× real time)"), "{table}");
+        assert!(table.contains("8.00 s (1.81×)"), "{table}");
+        let json = to_json("machine", &[], &[], &[], &[], &[], None, Some(&demo));
+        assert!(json.contains(
+            "\"demo_render\": {\"threads\": 2, \"audio_s\": 14.500000, \"first_s\": 14.000000"
+        ));
+        assert!(to_json("machine", &[], &[], &[], &[], &[], None, None)
+            .contains("\"demo_render\": null"));
     }
 
     #[test]
@@ -1270,7 +1427,7 @@ mod tests {
             "{}",
             row.spectral_distance_db
         );
-        let json = to_json("machine", &[], &[], &[], &[], &[], Some(&refinement));
+        let json = to_json("machine", &[], &[], &[], &[], &[], Some(&refinement), None);
         assert!(json.contains(
             "\"reference_refinement\": {\"intervals\": 800, \"oversample\": 16, \"tiers\": \
              [{\"tier\": \"reference\""

@@ -581,7 +581,7 @@ fn progress_line(
 /// One string's as-played calibration as a render took it: where it came from and how long it
 /// took to read or measure.
 #[derive(Debug, Clone, Copy)]
-struct Tuned {
+pub(crate) struct Tuned {
     calibration: Calibration,
     source: Source,
     seconds: f64,
@@ -607,7 +607,7 @@ struct Tuned {
 /// was stuck in a long one while the render could have gone on, 12.9 s against 11.7-12.4 s for
 /// the studio's first render.) Returns the calibrations taken, in the order of
 /// [`calibration_requests`].
-fn render_on(
+pub(crate) fn render_on(
     jobs: usize,
     settings: &EngineSettings,
     score: &Score,
