@@ -1003,16 +1003,30 @@ fn json_number(value: Option<f64>) -> String {
     }
 }
 
-pub fn to_json(
-    machine: &str,
-    results: &[BenchResult],
-    economy: &[EconomyRow],
-    keys: &[KeySpeeds],
-    grid: &[TierOverGrid],
-    grid_against_refined: &[TierOverGrid],
-    refinement: Option<&ReferenceRefinement>,
-    demo: Option<&DemoRender>,
-) -> String {
+/// Everything one run measured, as [`to_json`] writes it.
+#[derive(Default)]
+pub struct Report<'a> {
+    pub machine: &'a str,
+    pub results: &'a [BenchResult],
+    pub economy: &'a [EconomyRow],
+    pub keys: &'a [KeySpeeds],
+    pub grid: &'a [TierOverGrid],
+    pub grid_against_refined: &'a [TierOverGrid],
+    pub refinement: Option<&'a ReferenceRefinement>,
+    pub demo: Option<&'a DemoRender>,
+}
+
+pub fn to_json(report: &Report<'_>) -> String {
+    let Report {
+        machine,
+        results,
+        economy,
+        keys,
+        grid,
+        grid_against_refined,
+        refinement,
+        demo,
+    } = *report;
     let rows: Vec<String> = results
         .iter()
         .map(|r| {
@@ -1188,7 +1202,7 @@ fn run_demo_render() -> Option<DemoRender> {
         }
     };
     let cache = CalibrationCache::at(directory.path().to_path_buf(), "bench");
-    let mut timed = |what: &str| {
+    let timed = |what: &str| {
         eprintln!("bench: the demo render, {what} ...");
         let started = Instant::now();
         let rendered = render_on(
@@ -1309,16 +1323,16 @@ pub fn run(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     if let Some(path) = json {
         std::fs::write(
             &path,
-            to_json(
-                &machine,
-                &results,
-                &economy,
-                &keys,
-                &grid,
-                &grid_against_refined,
-                refinement.as_ref(),
-                demo.as_ref(),
-            ),
+            to_json(&Report {
+                machine: &machine,
+                results: &results,
+                economy: &economy,
+                keys: &keys,
+                grid: &grid,
+                grid_against_refined: &grid_against_refined,
+                refinement: refinement.as_ref(),
+                demo: demo.as_ref(),
+            }),
         )
         .map_err(|error| format!("cannot write `{}`: {error}", path.display()))?;
     }
@@ -1361,7 +1375,11 @@ mod tests {
         ));
         let table = key_speeds_markdown(std::slice::from_ref(&live));
         assert!(table.contains("| live | 88.00× (key 60) | 104.00× | 150.00× (key 36) |"));
-        let json = to_json("machine", &[], &[], &[live], &[], &[], None, None);
+        let json = to_json(&Report {
+            machine: "machine",
+            keys: &[live],
+            ..Report::default()
+        });
         assert!(json.contains("{\"tier\": \"live\", \"key\": 60, \"realtime_factor\": 88.000000}"));
     }
 
@@ -1392,12 +1410,15 @@ mod tests {
         let table = demo_render_markdown(&demo);
         assert!(table.contains("14.00 s (1.04× real time)"), "{table}");
         assert!(table.contains("8.00 s (1.81×)"), "{table}");
-        let json = to_json("machine", &[], &[], &[], &[], &[], None, Some(&demo));
+        let json = to_json(&Report {
+            machine: "machine",
+            demo: Some(&demo),
+            ..Report::default()
+        });
         assert!(json.contains(
             "\"demo_render\": {\"threads\": 2, \"audio_s\": 14.500000, \"first_s\": 14.000000"
         ));
-        assert!(to_json("machine", &[], &[], &[], &[], &[], None, None)
-            .contains("\"demo_render\": null"));
+        assert!(to_json(&Report::default()).contains("\"demo_render\": null"));
     }
 
     #[test]
@@ -1427,7 +1448,11 @@ mod tests {
             "{}",
             row.spectral_distance_db
         );
-        let json = to_json("machine", &[], &[], &[], &[], &[], Some(&refinement), None);
+        let json = to_json(&Report {
+            machine: "machine",
+            refinement: Some(&refinement),
+            ..Report::default()
+        });
         assert!(json.contains(
             "\"reference_refinement\": {\"intervals\": 800, \"oversample\": 16, \"tiers\": \
              [{\"tier\": \"reference\""
