@@ -332,7 +332,9 @@ fn the_studio_plays_the_jawari_the_reference_sets() {
 /// studio tier, the fine string stepped at twice the output rate, follows it at both velocities
 /// (measured: within 0.5 cents); the fine tier, stepped at the output rate, takes the other
 /// branch at 127 (−6.67 against +3.54 cents, `examples/as_played.rs`, stop 57), the contact's
-/// time step again (`docs/modal-tanpura.md` §13).
+/// time step again (`docs/modal-tanpura.md` §13). Only at these two velocities: between them the
+/// studio is bistable too, and a sweep of velocities 88–127 (stop 58, `docs/tiers-log.md`) puts
+/// it up to 2.52 cents from the reference at 115, 2.46 at 121 and 2.06 at 118.
 #[test]
 fn at_a_bistable_key_the_studio_plays_the_references_hard_plucks() {
     let key = 53u8;

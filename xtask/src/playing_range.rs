@@ -1,5 +1,5 @@
 //! The bench's playing-range grid: every tier against the reference on every pluck of
-//! [`javari_core::analysis::playing_range::full_grid`] (keys 36–64, four velocities, two pluck
+//! [`javari_core::analysis::playing_range::full_grid`] (keys 36–64, six velocities, two pluck
 //! positions), measured by [`javari_core::analysis::listening`]: worst case and median of each
 //! measure over the grid, and the worst point named.
 //!
@@ -27,7 +27,7 @@ use javari_core::analysis::listening::{
 };
 use javari_core::analysis::playing_range::{
     calibration_request, full_grid, render_as_played, settings_for, GridPoint, CREST_KEYS, KEYS,
-    NOTE_SECONDS, PLUCK_POSITIONS_M,
+    NOTE_SECONDS, PLUCK_POSITIONS_M, VELOCITIES,
 };
 use javari_core::analysis::refined::{
     grid_render_linearised, grid_render_refined, yardstick_grid, YARDSTICK_REFINEMENT,
@@ -382,12 +382,13 @@ pub fn to_markdown(results: &[TierOverGrid]) -> String {
     let grid = full_grid();
     let mut text = format!(
         "\nAcross the playing range ({} single plucks: keys 36–64 every third semitone and 64 \
-         and every crest key 48–54, velocities 1/40/80/127, plucks at 0.35 and 0.20 m; {:.1} s \
+         and every crest key 48–54, velocities {}, plucks at 0.35 and 0.20 m; {:.1} s \
          each, against the reference render of the same pluck; measures defined in \
          `core/src/analysis/listening.rs`), worst / median over the grid:\n\n\
          | tier | sustained pitch (0.3–1.5 s), cents | glide (first 0.3 s), cents | 1/6-octave band levels to 16 kHz, dB RMS | centroid course | worst pitch at | worst bands at |\n\
          |---|---|---|---|---|---|---|\n",
         grid.len(),
+        VELOCITIES.map(|velocity| velocity.to_string()).join("/"),
         NOTE_SECONDS
     );
     for tier in results

@@ -17,8 +17,13 @@ use crate::tanpura::VoiceSettings;
 /// fine tier's hardest pluck sounded 10 cents from the reference's (stop 57,
 /// `core/tests/tanpura_as_played.rs`), where the keys beside it agreed within a cent.
 pub const KEYS: [u8; 15] = [36, 39, 42, 45, 48, 49, 50, 51, 52, 53, 54, 57, 60, 63, 64];
-/// MIDI velocities, from the softest to the hardest.
-pub const VELOCITIES: [u8; 4] = [1, 40, 80, 127];
+/// MIDI velocities, from the softest to the hardest: denser at the hard end (steps of 20, 15
+/// and 12 above 80), where the contact's nonlinearity grows with the amplitude and a string at
+/// the crest may be bistable. With 1, 40, 80 and 127 alone (stops 51–57) the grid missed what a
+/// sweep of key 53 over velocities 88–127 showed (stop 58): the studio tier 2.52 cents from the
+/// reference at velocity 115 and the fine tier 13.25 cents at 124, where both lay within 0.24
+/// and 10.21 cents of it at 127.
+pub const VELOCITIES: [u8; 6] = [1, 40, 80, 100, 115, 127];
 /// Pluck positions, m from the tuning bead: the instrument's default and one nearer the bridge.
 pub const PLUCK_POSITIONS_M: [f64; 2] = [0.35, 0.20];
 /// Length of each render, s: the sustained pitch is measured up to 1.5 s.
