@@ -602,10 +602,11 @@ pub(crate) struct Tuned {
 /// no calibration itself, so that it resumes as soon as that one is done. The calibrations are
 /// queued in the order their strings are first plucked, so the render of the first notes
 /// proceeds while the later strings are measured. (Stop 58 measured three ways on two cores: the
-/// render on a thread outside the pool paid a pool hand-over per block, 0.81 s against 0.44 s
-/// for the demo at the live tier; a render thread that measured queued strings while it waited
-/// was stuck in a long one while the render could have gone on, 12.9 s against 11.7-12.4 s for
-/// the studio's first render.) Returns the calibrations taken, in the order of
+/// render on a thread outside the pool paid a pool hand-over per block, 0.79-0.81 s against
+/// 0.41-0.44 s for the demo at the live tier with its calibrations read back; a render thread
+/// that measured queued strings while it waited could be stuck in a long one while the render
+/// could have gone on, 12.91-13.00 s against 11.72-12.39 s for the studio's first render.)
+/// Returns the calibrations taken, in the order of
 /// [`calibration_requests`].
 pub(crate) fn render_on(
     jobs: usize,

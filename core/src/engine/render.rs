@@ -208,13 +208,19 @@ pub fn calibration_need_samples(
     let clamped = settings.clamped();
     let fixed_sa = clamped.drone.enabled && clamped.drone.sa_note.is_some();
     let mut needed_at: Vec<Option<usize>> = vec![fixed_sa.then_some(0); requests.len()];
+    // A note's strings are needed from its first note-on; its later ones change nothing.
+    let mut played = [false; 128];
     for event in &score.events {
         let ScoreAction::Engine(EngineEvent::NoteOn { note, velocity }) = event.action else {
             continue;
         };
-        if velocity <= 0.0 {
+        let Some(first) = played.get_mut(usize::from(note)) else {
+            continue;
+        };
+        if velocity <= 0.0 || *first {
             continue;
         }
+        *first = true;
         let at = time_to_sample(event.time_s, sample_rate_hz);
         for string in Engine::planned_strings(settings, &[note]) {
             for (request, needed) in requests.iter().zip(needed_at.iter_mut()) {
