@@ -309,7 +309,7 @@ fn latency_follows_the_tier_and_lower_latency_voices_are_delayed_to_it() {
     let oversampled_latency =
         Engine::new(&at(Quality::Reference, Instrument::Tanpura), 44_100.0, 1).latency_samples();
     println!(
-        "latency: {oversampled_latency} samples at the oversampled tiers (studio 2x, reference 4x)"
+        "latency: {oversampled_latency} samples at the oversampled tiers (studio and reference, 4x)"
     );
     assert!(
         oversampled_latency > 1.0 && oversampled_latency < 64.0,

@@ -421,7 +421,7 @@ fn a_string_with_raised_stiffness_keeps_the_energy_balance() {
     assert!(worst_balance <= 1e-10, "balance error {worst_balance:e}");
 }
 
-/// The studio tier is the fine tier's string stepped at twice the rate: at every key the two,
+/// The studio tier is the fine tier's string stepped at four times the rate: at every key the two,
 /// tuned by their voices, take the same tension and rest in the same place at every contact
 /// point (the rest state and the tuning are statics, which the time step does not enter), so
 /// the studio's string rests where the fine's does, and with it where the reference's does
@@ -448,7 +448,10 @@ fn the_studio_tier_rests_where_the_fine_tier_rests() {
                 .expect("the studio tier is modal"),
             fine.string().as_modal().expect("the fine tier is modal"),
         );
-        assert_eq!(studio.config().time_step_s, 0.5 * fine.config().time_step_s);
+        assert_eq!(
+            studio.config().time_step_s,
+            0.25 * fine.config().time_step_s
+        );
         assert_eq!(
             studio.config().string.tension_n,
             fine.config().string.tension_n,

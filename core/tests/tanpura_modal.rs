@@ -611,9 +611,10 @@ fn a_change_of_the_losses_alone_keeps_the_thread_lattice_with_one_static_solve()
     }
 }
 
-/// The studio tier's own string (`docs/modal-tanpura.md` §13: the fine tier's, with the modal
-/// step halved): lossless, H is conserved to 1e-10 in contact; lossy, `H + losses = H₀` to
-/// 1e-10 and H never rises. Half a second at its step of 1/88 200 s.
+/// The studio tier's own string (`docs/modal-tanpura.md` §13: the fine tier's, stepped at the
+/// reference's step, a quarter of the fine tier's): lossless, H is conserved to 1e-10 in
+/// contact; lossy, `H + losses = H₀` to 1e-10 and H never rises. A quarter of a second at its
+/// step of 1/176 400 s.
 #[test]
 fn the_studio_tiers_string_keeps_the_balance_at_its_own_step() {
     use javari_core::tanpura::quality::Quality;
@@ -626,8 +627,8 @@ fn the_studio_tiers_string_keeps_the_balance_at_its_own_step() {
         .modal_config_at(Quality::Studio, SAMPLE_RATE)
         .expect("the studio tier is modal");
     config.track_energy = true;
-    assert_eq!(config.time_step_s, 0.5 / SAMPLE_RATE);
-    // Half a second: as many steps as a second has samples.
+    assert_eq!(config.time_step_s, 0.25 / SAMPLE_RATE);
+    // A quarter of a second: as many steps as a second has samples.
     let steps = SAMPLE_RATE as usize;
 
     let mut lossless = plucked::<f64>(config.lossless());
@@ -640,7 +641,7 @@ fn the_studio_tiers_string_keeps_the_balance_at_its_own_step() {
     );
     assert!(worst <= 1e-10, "lossless: relative energy drift {worst:e}");
 
-    // `lossy_run` takes seconds at the output rate; the studio takes two steps a sample.
+    // `lossy_run` takes seconds at the output rate; the studio takes four steps a sample.
     let (string, worst_increase, worst_balance) = lossy_run(config, steps as f64 / SAMPLE_RATE);
     assert!(string.cumulative_losses_j() > 0.0);
     assert!(

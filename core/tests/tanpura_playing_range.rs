@@ -95,8 +95,8 @@ fn the_live_tier_sounds_like_the_reference_across_the_range() {
 /// lie up to 14 cents away. Measured with the linearised tuning: sustained pitch 0.01–0.62
 /// cents, centroid course 0.4–13.5 %, both within issue 15's targets (1 cent, 15 %), which this
 /// test holds; band levels 0.6–3.9 dB at every pluck but key 54's hardest, 5.95 dB (issue 15's
-/// 5 dB missed there by 0.95 dB; the studio tier at 2× the output rate lay 5.76 dB from the
-/// reference at the same pluck). The test holds band levels to 6.5 dB.
+/// 5 dB missed there by 0.95 dB; the seed's FD scheme at 2× the output rate lay 5.76 dB from
+/// the reference at the same pluck). The test holds band levels to 6.5 dB.
 #[test]
 fn the_fine_tier_sounds_like_the_reference_at_the_crest_keys_and_away() {
     for (point, difference, _) in against_the_reference(Quality::Fine, &[39, 51, 54, 63]) {
@@ -125,9 +125,9 @@ fn the_studio_tier_sounds_like_the_reference_at_the_crest_keys() {
 
 /// The hardest pluck at key 54 (0.35 m) is where the contact's time step shows: tuned by
 /// linearisation, the fine string lies 5.68 dB from the reference in band levels stepped at the
-/// output rate and 3.55 dB at twice it, the studio tier (`grid_against_refined --
-/// --fine-rates`, stop 56; the FD studio of stops 37–56 lay 4.96 dB from it at 3×, 5.76 dB at
-/// 2×). This test holds the studio's pluck below 5.4 dB, so that a studio stepped at the output
+/// output rate and 3.55 dB at twice it (`grid_against_refined -- --fine-rates`, stop 56; the FD
+/// studio of stops 37–56 lay 4.96 dB from it at 3×, 5.76 dB at 2×). This test holds the studio's
+/// pluck, at four times the output rate, below 5.4 dB, so that a studio stepped at the output
 /// rate fails it.
 #[test]
 fn the_studio_tiers_hardest_pluck_keeps_the_references_band_levels() {

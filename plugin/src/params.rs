@@ -18,7 +18,7 @@
 //! | `plamp` | Pluck amplitude | mm | 0–5 | 2 | finger lift at full velocity |
 //! | `tout` | Tanpura output | | Radiated, Pickup | Radiated | the body's radiated sound (the total bridge force through the tanpura body of `core/src/tanpura/body.rs`), or the pickup forces below |
 //! | `pick` | Pickup | % nut | 0–100 | 100 | with output Pickup: 100: nut force, 0: bridge force |
-//! | `qual` | Quality | | Draft, Live, Fine, Studio, Reference | Fine | the core's tiers (`core/src/quality.rs`); not part of the factory presets |
+//! | `qual` | Quality | | Draft, Live, Fine, Studio, Reference | Fine | the core's tiers (`core/src/tanpura/quality.rs`); not part of the factory presets |
 //! | `gain` | Output gain | dB | −60–24 | 0 | after 2 N = full scale |
 //! | `drone` | Drone | on/off | | off | a held note sets Sa and the strings play the cycle |
 //! | `first` | First string | | Pa, Ma, Ni, komal Ni, Dha | Pa | first drone string: 3/4, 2/3, 15/16, 8/9 or 5/6 of Sa (just intonation) |

@@ -464,7 +464,7 @@ fn clap_latency_follows_the_tier_through_a_restart() {
     let studio_latency = engine_latency(Quality::Studio);
     println!(
         "latency at 44.1 kHz: {reference_latency} samples at the reference (4x), \
-         {studio_latency} at the studio tier (2x), 0 at the tiers at the output rate"
+         {studio_latency} at the studio tier (4x), 0 at the tiers at the output rate"
     );
     assert!(
         studio_latency > 0 && reference_latency > 0,

@@ -26,16 +26,18 @@
 //!   the same points (`docs/modal-tanpura.md` §10, stop 50; worst pluck of the playing range,
 //!   linearised tuning: 5.68 dB against 7.74 dB with points every 0.36 / 0.2 mm from the fine
 //!   string's own start, median 1.28 against 1.97 dB, for 18–26 % of the tier's speed).
-//! - Studio runs the fine tier's string stepped at twice the output rate (its grid modes keep the
-//!   poles of the reference's time step; the contact is solved every half output sample), decimated
-//!   by the reference's Kaiser filter (`fd/decimator.rs`, 29 samples of latency at 44.1 kHz, as the
-//!   reference's). The rest of the fine tier's distance from the reference at its worst plucks is
-//!   the contact's time step: over the playing range, tuned by linearisation, the fine string lies
-//!   0.53 cents, 5.68 dB and 12.6 % from the reference at worst at the output rate and 0.10 cents,
-//!   3.55 dB and 5.8 % at twice it (`docs/modal-tanpura.md` §12, stop 56). Until stop 57 the studio
-//!   tier was the seed's FD scheme at 3 × 44.1 kHz (with its EI raised to match the reference's
-//!   dispersion): 4.9 dB at worst and 4.5× real time per string, slower and less accurate than the
-//!   modal string at twice the rate, so it was replaced (`docs/tiers-log.md`, stop 57).
+//! - Studio runs the fine tier's string stepped at the reference's own step, four times the
+//!   output rate (its grid modes then step with the very poles they were given; the contact is
+//!   solved every quarter output sample), decimated by the reference's Kaiser filter
+//!   (`fd/decimator.rs`, 29 samples of latency at 44.1 kHz, as the reference's). What parts the
+//!   fine tier from the reference at its worst plucks is the contact's time step: at key 53,
+//!   bistable at hard plucks, the string stepped at twice the output rate (the studio of stops
+//!   57–58) lay up to 2.52 cents from the reference (velocity 115), and at four times it within
+//!   0.15 cents at every velocity 88–127 (`docs/modal-tanpura.md` §13, stop 58). It costs about
+//!   twice the 2× string's time, and still runs at about 1.8 times the reference's speed. Until
+//!   stop 57 the studio tier was the seed's FD scheme at 3 × 44.1 kHz (with its EI raised to
+//!   match the reference's dispersion): 4.9 dB at worst and 4.5× real time per string, slower
+//!   and less accurate than the modal string, so it was replaced (`docs/tiers-log.md`, stop 57).
 //! - Reference runs the seed's finite-difference scheme (`fd/`), its own discretisation
 //!   (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm, Δx_c = 0.15 mm) with a tolerance at
 //!   round-off.
@@ -111,8 +113,12 @@ pub fn reference_grid_modes(output_sample_rate_hz: f64) -> GridModes {
     }
 }
 
+/// The seed's time step: four steps per output sample (its section 5, at 44.1 kHz). The reference
+/// steps its FD scheme at it, and the studio tier the fine tier's string.
+const REFERENCE_OVERSAMPLE: usize = 4;
+
 /// The fine tier: the reference's grid modes and barrier points, stepped at the output rate.
-/// The studio tier is the same string stepped at twice the output rate.
+/// The studio tier is the same string stepped at the reference's step.
 const FINE_GRID: ModalTier = ModalTier {
     highest_mode_hz: 20_000.0,
     bridge_point_spacing_m: 0.18e-3,
@@ -157,11 +163,11 @@ impl Quality {
             }),
             Quality::Fine => Tier::Modal(FINE_GRID),
             Quality::Studio => Tier::Modal(ModalTier {
-                oversample: 2,
+                oversample: REFERENCE_OVERSAMPLE,
                 ..FINE_GRID
             }),
             Quality::Reference => Tier::FiniteDifference(FdTier {
-                oversample: 4,
+                oversample: REFERENCE_OVERSAMPLE,
                 intervals: 200,
                 newton: NewtonSettings::REFERENCE,
                 solver: SolverKind::Condensed,
@@ -255,25 +261,30 @@ mod tests {
     }
 
     /// The studio tier is the fine tier's string (its grid modes with the poles of the
-    /// reference's time step, its points, its Newton) stepped at twice the output rate.
+    /// reference's time step, its points, its Newton) stepped at the reference's own step.
     #[test]
-    fn studio_is_the_fine_string_at_twice_the_rate() {
+    fn studio_is_the_fine_string_at_the_references_step() {
         let fine = Quality::Fine.modal_tier().unwrap();
         let studio = Quality::Studio.modal_tier().unwrap();
         assert_eq!(
             studio,
             ModalTier {
-                oversample: 2,
+                oversample: 4,
                 ..fine
             }
         );
-        assert_eq!(Quality::Studio.oversample(), 2);
+        assert_eq!(
+            Quality::Studio.oversample(),
+            Quality::Reference.oversample()
+        );
         let settings = crate::tanpura::VoiceSettings::default();
         let rate = 44_100.0;
         let fine = settings.modal_config_at(Quality::Fine, rate).unwrap();
         let studio = settings.modal_config_at(Quality::Studio, rate).unwrap();
-        assert_eq!(studio.time_step_s, 0.5 / rate);
-        assert_eq!(studio.grid_modes, Some(reference_grid_modes(rate)));
+        assert_eq!(studio.time_step_s, 0.25 / rate);
+        let grid = reference_grid_modes(rate);
+        assert_eq!(studio.grid_modes, Some(grid));
+        assert_eq!(studio.time_step_s, grid.time_step_s);
         assert_eq!(
             crate::tanpura::modal::ModalStringConfig {
                 time_step_s: fine.time_step_s,
