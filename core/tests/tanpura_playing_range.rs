@@ -95,8 +95,8 @@ fn the_live_tier_sounds_like_the_reference_across_the_range() {
 /// lie up to 14 cents away. Measured with the linearised tuning: sustained pitch 0.01–0.62
 /// cents, centroid course 0.4–13.5 %, both within issue 15's targets (1 cent, 15 %), which this
 /// test holds; band levels 0.6–3.9 dB at every pluck but key 54's hardest, 5.95 dB (issue 15's
-/// 5 dB missed there by 0.95 dB; the seed's FD scheme at 2× the output rate lay 5.76 dB from
-/// the reference at the same pluck). The test holds band levels to 6.5 dB.
+/// 5 dB missed there by 0.95 dB; the FD studio scheme of stops 37–56, run at 2× the output
+/// rate, lay 5.76 dB from the reference at the same pluck). The test holds band levels to 6.5 dB.
 #[test]
 fn the_fine_tier_sounds_like_the_reference_at_the_crest_keys_and_away() {
     for (point, difference, _) in against_the_reference(Quality::Fine, &[39, 51, 54, 63]) {
