@@ -72,6 +72,16 @@ fn assert_within(point: &GridPoint, difference: &ListeningDifference, cents: f64
     );
 }
 
+/// Fails unless the centroid course lies within `fraction` of the reference's.
+fn assert_centroid_within(point: &GridPoint, difference: &ListeningDifference, fraction: f64) {
+    assert!(
+        difference.centroid_error <= fraction,
+        "{}: centroid course {:.2} % from the reference",
+        point.label(),
+        100.0 * difference.centroid_error
+    );
+}
+
 #[test]
 fn the_live_tier_sounds_like_the_reference_across_the_range() {
     for (point, difference, reference) in against_the_reference(Quality::Live, &[39, 57, 63]) {
@@ -101,12 +111,7 @@ fn the_live_tier_sounds_like_the_reference_across_the_range() {
 fn the_fine_tier_sounds_like_the_reference_at_the_crest_keys_and_away() {
     for (point, difference, _) in against_the_reference(Quality::Fine, &[39, 51, 54, 63]) {
         assert_within(&point, &difference, 1.0, 6.5);
-        assert!(
-            difference.centroid_error <= 0.15,
-            "{}: centroid course {:.1} % from the reference",
-            point.label(),
-            100.0 * difference.centroid_error
-        );
+        assert_centroid_within(&point, &difference, 0.15);
     }
 }
 
@@ -124,12 +129,7 @@ fn the_fine_tier_sounds_like_the_reference_at_the_crest_keys_and_away() {
 fn the_studio_tier_sounds_like_the_reference_at_the_crest_keys() {
     for (point, difference, _) in against_the_reference(Quality::Studio, &[49, 50]) {
         assert_within(&point, &difference, 0.25, 0.6);
-        assert!(
-            difference.centroid_error <= 0.015,
-            "{}: centroid course {:.2} % from the reference",
-            point.label(),
-            100.0 * difference.centroid_error
-        );
+        assert_centroid_within(&point, &difference, 0.015);
     }
 }
 

@@ -927,9 +927,8 @@ pub fn targets_markdown(
             "the demo (`cargo xtask render`, reference tier), first render{}: faster than real \
              time",
             demo.map_or(String::new(), |demo| format!(
-                " on {} thread{}",
-                demo.threads,
-                if demo.threads == 1 { "" } else { "s" }
+                " on {}",
+                demo.threads_label()
             ))
         ),
         demo.map(DemoRender::first_factor),
@@ -1178,6 +1177,12 @@ pub struct DemoRender {
 }
 
 impl DemoRender {
+    /// "1 thread", "2 threads".
+    fn threads_label(&self) -> String {
+        let plural = if self.threads == 1 { "" } else { "s" };
+        format!("{} thread{plural}", self.threads)
+    }
+
     pub fn first_factor(&self) -> f64 {
         self.audio_s / self.first_s
     }
@@ -1235,12 +1240,11 @@ fn run_demo_render() -> Option<DemoRender> {
 /// The markdown of [`DemoRender`].
 pub fn demo_render_markdown(demo: &DemoRender) -> String {
     format!(
-        "\nThe demo render (`cargo xtask render`: {:.1} s of audio, reference tier, {} thread{}): \
+        "\nThe demo render (`cargo xtask render`: {:.1} s of audio, reference tier, {}): \
          first render, every string's calibration measured alongside it, {:.2} s ({:.2}× real \
          time); again, the calibrations read back, {:.2} s ({:.2}×).\n",
         demo.audio_s,
-        demo.threads,
-        if demo.threads == 1 { "" } else { "s" },
+        demo.threads_label(),
         demo.first_s,
         demo.first_factor(),
         demo.again_s,
