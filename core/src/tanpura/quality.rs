@@ -36,10 +36,10 @@
 //!   0.15 cents at every velocity 88–127 (`docs/modal-tanpura.md` §13, stop 58); over the
 //!   playing range's 180 plucks it lies 0.32 cents, 0.75 dB and 2.1 % from the reference at
 //!   worst (stop 59). It costs about twice the 2× string's time and runs at 1.7–1.8 times the
-//!   reference's speed. Until
-//!   stop 57 the studio tier was the seed's FD scheme at 3 × 44.1 kHz (with its EI raised to
-//!   match the reference's dispersion): 4.9 dB at worst and 4.5× real time per string, slower
-//!   and less accurate than the modal string, so it was replaced (`docs/tiers-log.md`, stop 57).
+//!   reference's speed. Until stop 57 the studio tier was the seed's FD scheme at 3 × 44.1 kHz
+//!   (with its EI raised to match the reference's dispersion): 4.9 dB at worst and 4.5× real
+//!   time per string, slower and less accurate than the modal string, so it was replaced
+//!   (`docs/tiers-log.md`, stop 57).
 //! - Reference runs the seed's finite-difference scheme (`fd/`), its own discretisation
 //!   (section 5: 4 × 44.1 kHz, Δx = 3⅓ mm, Δx_b = 0.18 mm, Δx_c = 0.15 mm) with a tolerance at
 //!   round-off.
