@@ -1,16 +1,16 @@
-//! The plugin's default tier against the reference over a small grid of the playing range
-//! (issue 15): keys low, middle and high, a moderate and the hardest velocity, each a single
-//! pluck compared by the measures of `core/src/analysis/listening.rs`, the ones the bench's
+//! The tiers against the reference over small grids of the playing range (issue 15): keys low,
+//! middle and high and at the crest, a moderate and the hardest velocity, each a single pluck
+//! compared by the measures of `core/src/analysis/listening.rs`, the ones the bench's
 //! playing-range grid reports (`cargo xtask bench`).
 //!
-//! The keys lie outside the stretch (keys 48–54 at the seed's geometry) where the bridge crest's
-//! rest contact appears as the tension rises: there the tiers' tunings, each linearised about its
-//! own rest state, part by up to 14 cents (the bench's worst case, an open target). Elsewhere the
-//! live tier's sustained pitch agrees within about 2.3 cents (the modal string rests on the
-//! thread only where the reference also rests on the crest; `docs/modal-tanpura.md` §8); this
-//! test fails if that, or its band levels, or the reference's own tuning, parts. The studio
-//! tier, which shares the reference's rest state, is held to it at two of those keys too, and
-//! at key 54 plucked hardest, where its band levels lay furthest from the reference's.
+//! - The fine tier (the plugin's default) is the reference's grid in modes, so it is held to
+//!   the reference at the crest keys (keys 48–54 at the seed's geometry, where the bridge
+//!   crest's rest contact appears as the tension rises) as well as away from them.
+//! - The live tier's continuous modes rest on the thread alone where the reference rests on the
+//!   crest too (`docs/modal-tanpura.md` §8), so it is held away from the crest keys only, where
+//!   its sustained pitch agrees within about 2.3 cents.
+//! - The studio tier, the fine string at the reference's own step, is held to it at the crest
+//!   keys and at key 54 plucked hardest, where the contact's time step shows most.
 
 use javari_core::analysis::cents;
 use javari_core::analysis::listening::{compare, sustained_pitch_hz, ListeningDifference};

@@ -1,14 +1,16 @@
 //! Signal analysis for tests, benchmarks and the offline tools: FFT, windowed spectra, precise
 //! partial frequencies, spectral centroids and band energies; [`listening`] defines what a
 //! listener compares between two renders, [`playing_range`] the grid of plucks the tiers are
-//! compared on, [`refined`] the reference's string on finer grids. Not used on the audio thread
-//! (the editor's spectrum calls [`fft`] on the GUI thread).
+//! compared on, [`precursor`] the seed's precursor in the nut force, [`refined`] the reference's
+//! string on finer grids. Not used on the audio thread (the editor's spectrum calls [`fft`] on
+//! the GUI thread).
 //!
 //! The transforms are rustfft's (complex) and realfft's (real input), planned once per length and
 //! thread and reused: these tools call them thousands of times with a handful of lengths.
 
 pub mod listening;
 pub mod playing_range;
+pub mod precursor;
 pub mod refined;
 
 use realfft::num_complex::Complex;

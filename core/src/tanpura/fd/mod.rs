@@ -1,6 +1,7 @@
 //! The seed's finite-difference scheme: one tanpura string in distributed contact with a curved
 //! bridge and a cotton thread, stepped one sample of the internal (oversampled) rate at a time.
-//! The discretisation of the studio and reference tiers.
+//! The discretisation of the reference tier (and of the studio tier until stop 57, when it became
+//! the fine tier's modal string at the reference's step, `quality.rs`).
 //!
 //! Source: seed 000 (van Walstijn & Chatziioannou, ISMA 2014), eq. 5–25, restated in
 //! `shared/notes/tanpura-model.md`; configuration "B" of its Figure 2 (the string runs from the
@@ -89,9 +90,10 @@ pub struct FdStringConfig {
     /// leaves it off). Also switchable on a built string with [`FdString::set_track_energy`].
     pub track_energy: bool,
     /// The bending stiffness the rest state is solved with, N·m², where it differs from the
-    /// string's (`None`: the string's own). The studio tier raises EI so that its vibration has
-    /// the reference's dispersion (`voice.rs`); with the true EI here its string still rests
-    /// where the reference's rests (see [`FdString`]'s rest preload).
+    /// string's (`None`: the string's own). The FD studio tier of stops 34–56 raised EI so that
+    /// its vibration had the reference's dispersion; with the true EI here its string still
+    /// rested where the reference's rests (see [`FdString`]'s rest preload). No tier sets it now;
+    /// the invariant tests keep it working.
     pub rest_bending_stiffness_n_m2: Option<f64>,
 }
 
