@@ -57,7 +57,7 @@ pub fn fold_precursor(
 ) -> PrecursorFold {
     let nominal_period = sample_rate_hz / nominal_hz;
     assert!(
-        end <= signal.len() && (end - start) as f64 >= 4.0 * nominal_period,
+        start < end && end <= signal.len() && (end - start) as f64 >= 4.0 * nominal_period,
         "the span must lie in the signal and hold four periods"
     );
     let span = &signal[start..end];
