@@ -9,8 +9,8 @@
 //! The draft tier is not held to these shapes: at the seed's string its upper band's share of
 //! the nut force falls from the pluck on (0.030 at 0.05 s, 0.004 at 3 s; with k_b = 0 beyond the
 //! thread 0.043 and 0.004), and its high band folds flat on the period (a quarter period holds
-//! 0.34 of it over 0.1–0.5 s, as without the bridge beyond the thread 0.29), so its bridge feeds
-//! neither the formant nor the precursor (`docs/modal-tanpura.md` §14).
+//! 0.32 of it over 0.1–0.5 s; the grid tiers without the bridge beyond the thread, 0.29), so its
+//! bridge feeds neither the formant nor the precursor (`docs/modal-tanpura.md` §14).
 
 use javari_core::analysis::precursor::{fold_precursor, PrecursorFold};
 use javari_core::analysis::{band_power, power_spectrum, spectral_centroid_hz};
@@ -104,9 +104,9 @@ fn without_the_bridge_beyond_the_thread_upper_partials_never_gain_share() {
 
 /// The precursor is held on the tiers whose string is the reference's grid (fine, studio) and on
 /// the reference. The live tier carries the packet in the band above 10 f0 (a quarter period holds
-/// 0.72 of it over 0.1–0.5 s, 0.13 of a period ahead of the main pulse) but not above 40 f0 (0.29,
-/// as without the bridge beyond the thread; 0.33 above 20 f0): its modes stop at 20 kHz and its
-/// bridge points lie 2 mm apart. The draft tier carries none (0.34 above 10 f0).
+/// 0.65 of it over 0.1–0.5 s, 0.10 of a period ahead of the main pulse) but not above 40 f0 (0.29,
+/// as without the bridge beyond the thread): its modes stop at 20 kHz and its bridge points lie
+/// 2 mm apart. The draft tier carries none (0.32 above 10 f0).
 const PRECURSOR_TIERS: [Quality; 3] = [Quality::Fine, Quality::Studio, Quality::Reference];
 
 /// The nut force's band above `packet_above_f0` times the fundamental, folded on the period over
@@ -131,12 +131,12 @@ fn precursor(
 
 /// Seed 000, section 5.2 and Figure 4, on the default pluck, each fold over part of the first
 /// half second (`analysis::precursor`), the main pulse taken on the band below 10 f0. Measured on
-/// fine / studio / reference: over 0.1–0.5 s a quarter period holds 0.73 / 0.74 / 0.74 of the
-/// band above 10 f0, centred 0.13 / 0.12 / 0.12 of a period ahead of the main pulse; the band
-/// above 40 f0 arrives earlier, 0.18 / 0.21 / 0.21 of a period ahead; the half period opposite
-/// the packet holds 0.16 of the band over the first 0.1 s and 0.11 over 0.1–0.5 s. With k_b = 0
-/// beyond the thread a quarter holds 0.33, about what a band spread evenly over the period gives
-/// (0.25) plus the beating of its strongest partials.
+/// fine / studio / reference: over 0.1–0.5 s a quarter period holds 0.70 / 0.71 / 0.71 of the
+/// band above 10 f0, centred 0.13 / 0.12 / 0.13 of a period ahead of the main pulse; the band
+/// above 40 f0 arrives earlier, 0.20 / 0.21 / 0.23 of a period ahead; the half period opposite
+/// the packet holds 0.16 of the band over the first 0.1 s and 0.11–0.12 over 0.1–0.5 s. With
+/// k_b = 0 beyond the thread a quarter holds 0.29, about what a band spread evenly over the
+/// period gives (0.25) plus the beating of its strongest partials.
 #[test]
 fn a_precursor_reaches_the_nut_once_a_period_ahead_of_the_main_pulse() {
     for quality in PRECURSOR_TIERS {

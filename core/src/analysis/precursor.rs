@@ -6,11 +6,11 @@
 //! Over a span of a nut-force signal, [`fold_precursor`] measures that shape by synchronous
 //! averaging:
 //!
-//! 1. the span's period, from its autocorrelation within 10 % of the nominal period, refined by
-//!    a parabola through the peak;
+//! 1. the span's period, from its fundamental's frequency ([`super::peak_frequency_hz`] within
+//!    10 % of the nominal);
 //! 2. the high band, where the packet is sought, and the low band, where the main pulse is (each
-//!    by an FFT of the span with a margin on either side, the bins on the other side of the
-//!    cut-off zeroed: a zero-phase filter, so the packet and the pulse keep their places);
+//!    from one FFT of the span with a margin on either side, the bins outside the band zeroed: a
+//!    zero-phase filter, so the packet and the pulse keep their places);
 //! 3. the high band's energy `h²` and the low band folded on that period into [`PHASE_BINS`]
 //!    phase bins (each bin the mean of its samples);
 //! 4. the packet: the quarter period (circularly) that holds the most folded energy, its share
@@ -22,7 +22,7 @@
 //! beat with each other drift through the period and fold into a flat profile (a quarter holds
 //! about a quarter of the energy). Offline only: it allocates.
 
-use super::REAL_PLANNER;
+use super::{peak_frequency_hz, REAL_PLANNER};
 
 /// Phase bins of one period in the fold.
 pub const PHASE_BINS: usize = 64;
@@ -61,42 +61,36 @@ pub fn fold_precursor(
         "the span must lie in the signal and hold four periods"
     );
     let span = &signal[start..end];
-    let period = period_samples(span, nominal_period);
-    let high = high_band(signal, start, end, packet_above_hz / sample_rate_hz);
-    let energy: Vec<f64> = high.iter().map(|h| h * h).collect();
+    let period = sample_rate_hz
+        / peak_frequency_hz(span, sample_rate_hz, 0.9 * nominal_hz, 1.1 * nominal_hz);
+    let (low_band, high_band) = split_bands(
+        signal,
+        start,
+        end,
+        pulse_below_hz / sample_rate_hz,
+        packet_above_hz / sample_rate_hz,
+    );
+    let energy: Vec<f64> = high_band.iter().map(|h| h * h).collect();
     let energy_profile = fold(&energy, period);
-    let above_pulse = high_band(signal, start, end, pulse_below_hz / sample_rate_hz);
-    let low_band: Vec<f64> = span.iter().zip(&above_pulse).map(|(x, h)| x - h).collect();
     let waveform = fold(&low_band, period);
 
     let quarter = PHASE_BINS / 4;
     let total: f64 = energy_profile.iter().sum();
     let (packet_start, packet_energy) = (0..PHASE_BINS)
         .map(|first| (first, circular_sum(&energy_profile, first, quarter)))
-        .fold((0, f64::MIN), |best, candidate| {
-            if candidate.1 > best.1 {
-                candidate
-            } else {
-                best
-            }
-        });
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("the period has bins");
     let packet_centre = packet_start as f64 + quarter as f64 / 2.0;
     let opposite_first = (packet_start + quarter / 2 + PHASE_BINS / 4) % PHASE_BINS;
     let opposite_energy = circular_sum(&energy_profile, opposite_first, PHASE_BINS / 2);
 
-    let steepest = (0..PHASE_BINS)
-        .map(|bin| {
-            let change = waveform[(bin + 1) % PHASE_BINS] - waveform[bin];
-            (bin as f64 + 0.5, change.abs())
+    let steepest_bin = (0..PHASE_BINS)
+        .max_by(|&a, &b| {
+            let change = |bin: usize| (waveform[(bin + 1) % PHASE_BINS] - waveform[bin]).abs();
+            change(a).total_cmp(&change(b))
         })
-        .fold((0.0, f64::MIN), |best, candidate| {
-            if candidate.1 > best.1 {
-                candidate
-            } else {
-                best
-            }
-        })
-        .0;
+        .expect("the period has bins");
+    let steepest = steepest_bin as f64 + 0.5;
     let lead = (steepest - packet_centre).rem_euclid(PHASE_BINS as f64) / PHASE_BINS as f64;
     PrecursorFold {
         period_samples: period,
@@ -106,40 +100,17 @@ pub fn fold_precursor(
     }
 }
 
-/// The period of `span` in samples: the largest autocorrelation at lags within 10 % of
-/// `nominal`, refined by the parabola through it and its neighbours.
-fn period_samples(span: &[f64], nominal: f64) -> f64 {
-    let mean = span.iter().sum::<f64>() / span.len() as f64;
-    let centred: Vec<f64> = span.iter().map(|x| x - mean).collect();
-    let correlation = |lag: usize| -> f64 {
-        centred[..centred.len() - lag]
-            .iter()
-            .zip(&centred[lag..])
-            .map(|(a, b)| a * b)
-            .sum()
-    };
-    let lowest = (0.9 * nominal).floor().max(2.0) as usize;
-    let highest = (1.1 * nominal).ceil() as usize;
-    let best = (lowest..=highest)
-        .max_by(|&a, &b| correlation(a).total_cmp(&correlation(b)))
-        .expect("the lag range is not empty");
-    let (before, at, after) = (
-        correlation(best - 1),
-        correlation(best),
-        correlation(best + 1),
-    );
-    let curvature = before - 2.0 * at + after;
-    if curvature < 0.0 {
-        best as f64 + 0.5 * (before - after) / curvature
-    } else {
-        best as f64
-    }
-}
-
-/// `signal[start..end]` above `cutoff` (cycles per sample): the span and a margin of up to a
-/// quarter of its length on either side (so the transform's wrap-around falls outside the
-/// span), transformed, every bin below the cut-off zeroed, transformed back.
-fn high_band(signal: &[f64], start: usize, end: usize, cutoff: f64) -> Vec<f64> {
+/// `signal[start..end]` below `low_cutoff` and above `high_cutoff` (cycles per sample): the span
+/// and a margin of up to a quarter of its length on either side (so the transform's wrap-around
+/// falls outside the span), transformed once, and each band transformed back with the bins
+/// outside it zeroed.
+fn split_bands(
+    signal: &[f64],
+    start: usize,
+    end: usize,
+    low_cutoff: f64,
+    high_cutoff: f64,
+) -> (Vec<f64>, Vec<f64>) {
     let margin = (end - start) / 4;
     let first = start.saturating_sub(margin);
     let last = (end + margin).min(signal.len());
@@ -157,25 +128,37 @@ fn high_band(signal: &[f64], start: usize, end: usize, cutoff: f64) -> Vec<f64> 
     forward
         .process(&mut frame, &mut spectrum)
         .expect("buffers come from the plan itself");
-    for (bin, value) in spectrum.iter_mut().enumerate() {
-        if (bin as f64) < cutoff * length as f64 {
-            *value = Default::default();
+    let band = |keep: &dyn Fn(f64) -> bool| -> Vec<f64> {
+        let mut part: Vec<_> = spectrum
+            .iter()
+            .enumerate()
+            .map(|(bin, &value)| {
+                if keep(bin as f64 / length as f64) {
+                    value
+                } else {
+                    Default::default()
+                }
+            })
+            .collect();
+        // The real inverse wants the Nyquist bin's imaginary part zero, as a real input gives.
+        if length.is_multiple_of(2) {
+            if let Some(last_bin) = part.last_mut() {
+                last_bin.im = 0.0;
+            }
         }
-    }
-    // The real inverse wants the Nyquist bin's imaginary part zero, as a real input gives.
-    if length.is_multiple_of(2) {
-        if let Some(last_bin) = spectrum.last_mut() {
-            last_bin.im = 0.0;
-        }
-    }
-    let mut band = inverse.make_output_vec();
-    inverse
-        .process(&mut spectrum, &mut band)
-        .expect("buffers come from the plan itself");
-    band[start - first..end - first]
-        .iter()
-        .map(|value| value / length as f64)
-        .collect()
+        let mut output = inverse.make_output_vec();
+        inverse
+            .process(&mut part, &mut output)
+            .expect("buffers come from the plan itself");
+        output[start - first..end - first]
+            .iter()
+            .map(|value| value / length as f64)
+            .collect()
+    };
+    (
+        band(&|frequency| frequency < low_cutoff),
+        band(&|frequency| frequency >= high_cutoff),
+    )
 }
 
 /// The mean of `values` in each of [`PHASE_BINS`] bins of phase `(i / period) mod 1`.
