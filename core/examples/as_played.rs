@@ -1,7 +1,7 @@
 //! The sustained pitch as played (0.3–1.5 s after the pluck) against each key's target, for one
 //! tier, with the linearised tuning alone and with the as-played calibration
 //! (`tanpura/as_played.rs`): `cargo run --release -p javari-core --example as_played -- TIER KEY…`
-//! (TIER: draft, live, studio or reference; keys default to 36–64; an argument such as `41mm`
+//! (TIER: live, fine, studio or reference; keys default to 36–64; an argument such as `41mm`
 //! moves the thread from its 40 mm, one such as `pluck=0.20` plucks at 0.20 m from the bead
 //! instead of the default 0.35 m). One row per key: the calibration's offset (cents) and thread
 //! move (mm), then one column per MIDI velocity, cents from the key's pitch, with the linearised

@@ -42,12 +42,7 @@ use javari_core::tanpura::VoiceSettings;
 use rayon::prelude::*;
 
 const SAMPLE_RATE_HZ: f64 = 44_100.0;
-const TIERS: [Quality; 4] = [
-    Quality::Reference,
-    Quality::Studio,
-    Quality::Live,
-    Quality::Draft,
-];
+const TIERS: [Quality; 3] = [Quality::Reference, Quality::Studio, Quality::Live];
 
 /// Each tier's distance from the refined render of `point`, in the order of [`TIERS`].
 fn measure(point: &GridPoint, residual_modes: usize) -> Vec<ListeningDifference> {

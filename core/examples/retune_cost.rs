@@ -2,7 +2,7 @@
 //! the thread position (a new rest state and the tuning passes), then 200 of γ only, each
 //! followed by one output sample, against the cost of one sample and a 64-sample block's
 //! deadline. `cargo run --release -p javari-core --example retune_cost [TIER ...] [key=NN]`
-//! (docs/performance.md); with tier names (draft, live, fine, studio) only those tiers, with `key=NN`
+//! (docs/performance.md); with tier names (live, fine, studio) only those tiers, with `key=NN`
 //! the string at that MIDI key instead of D3.
 
 use javari_core::engine::pitch::note_to_hz;
@@ -36,12 +36,7 @@ fn main() {
         .find_map(|arg| arg.strip_prefix("key="))
         .map_or(146.8, |key| note_to_hz(key.parse().expect("key=NN")));
     let chosen: Vec<&String> = args.iter().filter(|arg| !arg.starts_with("key=")).collect();
-    let tiers = [
-        Quality::Draft,
-        Quality::Live,
-        Quality::Fine,
-        Quality::Studio,
-    ];
+    let tiers = [Quality::Live, Quality::Fine, Quality::Studio];
     for quality in tiers.into_iter().filter(|quality| {
         chosen.is_empty() || chosen.iter().any(|name| name.as_str() == quality.name())
     }) {

@@ -26,7 +26,7 @@ fn settings(instrument: Instrument) -> EngineSettings {
         instrument,
         ..EngineSettings::default()
     };
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     settings
 }
 
@@ -82,7 +82,7 @@ fn every_number_set_to(value: f64, instrument: Instrument) -> EngineSettings {
         instrument,
         ..EngineSettings::default()
     };
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     settings.drone.enabled = instrument == Instrument::Tanpura;
     settings.drone.tempo_sync = false;
     let voice = &mut settings.voice;

@@ -6,11 +6,10 @@
 //! ones the earlier, as the string's stiffness has them travel faster; of the finger pluck's
 //! two packets the second fades.
 //!
-//! The draft tier is not held to these shapes: at the seed's string its upper band's share of
-//! the nut force falls from the pluck on (0.030 at 0.05 s, 0.004 at 3 s; with k_b = 0 beyond the
-//! thread 0.043 and 0.004), and its high band folds flat on the period (a quarter period holds
-//! 0.32 of it over 0.1–0.5 s; the grid tiers without the bridge beyond the thread, 0.29), so its
-//! bridge feeds neither the formant nor the precursor (`docs/modal-tanpura.md` §14).
+//! Every tier is held to the formant's shapes. The draft tier, whose upper band's share of the
+//! nut force fell from the pluck on (0.030 at 0.05 s, 0.004 at 3 s; with k_b = 0 beyond the
+//! thread 0.043 and 0.004), so that its bridge fed neither the formant nor the precursor, was
+//! withdrawn in stop 62 (`docs/modal-tanpura.md` §14).
 
 use javari_core::analysis::precursor::{fold_precursor, PrecursorFold};
 use javari_core::analysis::{band_power, power_spectrum, spectral_centroid_hz};
@@ -18,15 +17,10 @@ use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
 
-/// The formant's signature must hold for every discretisation but the draft tier's: the seed's FD
-/// scheme (reference), the modal scheme on the reference's grid (fine, the default tier, and
-/// studio, the same string at the reference's step) and on the continuous string's modes (live).
-const TIERS: [Quality; 4] = [
-    Quality::Live,
-    Quality::Fine,
-    Quality::Studio,
-    Quality::Reference,
-];
+/// The formant's signature must hold for every tier: the seed's FD scheme (reference), the modal
+/// scheme on the reference's grid (fine, the default tier, and studio, the same string at the
+/// reference's step) and on the continuous string's modes (live).
+const TIERS: [Quality; 4] = Quality::ALL;
 
 const SAMPLE_RATE: f64 = 44_100.0;
 const WINDOW: usize = 8192;
@@ -106,7 +100,7 @@ fn without_the_bridge_beyond_the_thread_upper_partials_never_gain_share() {
 /// the reference. The live tier carries the packet in the band above 10 f0 (a quarter period holds
 /// 0.65 of it over 0.1–0.5 s, 0.10 of a period ahead of the main pulse) but not above 40 f0 (0.29,
 /// as without the bridge beyond the thread): its modes stop at 20 kHz and its bridge points lie
-/// 2 mm apart. The draft tier carries none (0.32 above 10 f0).
+/// 2 mm apart.
 const PRECURSOR_TIERS: [Quality; 3] = [Quality::Fine, Quality::Studio, Quality::Reference];
 
 /// The nut force's band above `packet_above_f0` times the fundamental, folded on the period over

@@ -18,7 +18,7 @@
 //! | `plamp` | Pluck amplitude | mm | 0–5 | 2 | finger lift at full velocity |
 //! | `tout` | Tanpura output | | Radiated, Pickup | Radiated | the body's radiated sound (the total bridge force through the tanpura body of `core/src/tanpura/body.rs`), or the pickup forces below |
 //! | `pick` | Pickup | % nut | 0–100 | 100 | with output Pickup: 100: nut force, 0: bridge force |
-//! | `qual` | Quality | | Draft, Live, Fine, Studio, Reference | Fine | the core's tiers (`core/src/tanpura/quality.rs`); not part of the factory presets |
+//! | `qual` | Quality | | Live, Fine, Studio, Reference | Fine | the core's tiers (`core/src/tanpura/quality.rs`); not part of the factory presets; a state saved with the withdrawn Draft loads as Live |
 //! | `gain` | Output gain | dB | −60–24 | 0 | after 2 N = full scale |
 //! | `drone` | Drone | on/off | | off | a held note sets Sa and the strings play the cycle |
 //! | `first` | First string | | Pa, Ma, Ni, komal Ni, Dha | Pa | first drone string: 3/4, 2/3, 15/16, 8/9 or 5/6 of Sa (just intonation) |
@@ -133,11 +133,12 @@ pub enum BowedStringChoice {
     CelloD,
 }
 
-/// The core's quality tiers (`core/src/quality.rs`), cheapest first.
+/// The core's quality tiers (`core/src/tanpura/quality.rs`), cheapest first; each variant's ID is
+/// the tier's name. The draft tier, withdrawn in stop 62, left the list: a host's automation of
+/// this parameter recorded before then reads one tier up (its plain value is the variant's
+/// index), and a saved state's `"draft"` is migrated to live (`state::repair`).
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum QualityChoice {
-    #[id = "draft"]
-    Draft,
     #[id = "live"]
     Live,
     #[id = "fine"]
@@ -146,6 +147,18 @@ pub enum QualityChoice {
     Studio,
     #[id = "reference"]
     Reference,
+}
+
+impl QualityChoice {
+    /// The core's tier this choice plays.
+    pub fn quality(self) -> Quality {
+        match self {
+            QualityChoice::Live => Quality::Live,
+            QualityChoice::Fine => Quality::Fine,
+            QualityChoice::Studio => Quality::Studio,
+            QualityChoice::Reference => Quality::Reference,
+        }
+    }
 }
 
 /// What the tanpura's output is (`javari_core::engine::TanpuraOutput`).
@@ -627,13 +640,7 @@ impl JavariParams {
             PresetChoice::FiveString => Some(&factory[10]),
             PresetChoice::TanpuraMa => Some(&factory[11]),
         };
-        let quality = match self.quality.value() {
-            QualityChoice::Draft => Quality::Draft,
-            QualityChoice::Live => Quality::Live,
-            QualityChoice::Fine => Quality::Fine,
-            QualityChoice::Studio => Quality::Studio,
-            QualityChoice::Reference => Quality::Reference,
-        };
+        let quality = self.quality.value().quality();
         let tanpura_output = match self.tanpura_output.value() {
             TanpuraOutputChoice::Radiated => TanpuraOutput::Radiated,
             TanpuraOutputChoice::Pickup => TanpuraOutput::Pickup,

@@ -12,7 +12,10 @@
 //! - an ID the blob lacks, or holds with the wrong kind of value (a number for a switch, an
 //!   unknown enum ID), takes its default;
 //! - a number outside its parameter's range is clamped to the range (±∞ to the nearer end);
-//! - IDs Javari does not know are dropped.
+//! - IDs Javari does not know are dropped;
+//! - an enum ID of a choice Javari has withdrawn is migrated to the choice that took its place:
+//!   `qual = "draft"` (the draft tier, withdrawn in stop 62) loads as `"live"`
+//!   (`Quality::withdrawn`).
 //!
 //! Each repair is logged (`nice_warn!`) and returned, so that it is said, not silent.
 //!
@@ -27,11 +30,15 @@
 //! its defaults when the host has just created it. The host tests feed such blobs too.
 
 use crate::params::JavariParams;
+use javari_core::tanpura::quality::Quality;
 use nice_plug::params::internals::ParamPtr;
 use nice_plug::params::InternalParamMut;
 use nice_plug::plugin::ParamValue;
 use nice_plug::prelude::*;
 use std::collections::BTreeMap;
+
+/// The quality parameter's ID; its enum IDs are the core's tier names.
+const QUALITY_ID: &str = "qual";
 
 /// What [`repair`] changed in a state.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -44,6 +51,8 @@ pub struct StateRepairs {
     pub clamped: Vec<String>,
     /// IDs Javari does not know, dropped.
     pub dropped: Vec<String>,
+    /// IDs whose value named a withdrawn choice, now the choice that replaced it.
+    pub migrated: Vec<String>,
 }
 
 impl StateRepairs {
@@ -153,6 +162,12 @@ pub fn repair(state: &mut PluginState) -> StateRepairs {
         state.params.remove(id);
     }
     repairs.foreign = state.params.is_empty();
+    if let Some(ParamValue::String(tier)) = state.params.get_mut(QUALITY_ID) {
+        if let Some(quality) = Quality::withdrawn(tier) {
+            *tier = quality.name().to_owned();
+            repairs.migrated.push(QUALITY_ID.to_owned());
+        }
+    }
 
     for (id, param, _) in &params {
         // SAFETY: `param` points into `scratch`, alive until the end of this function.
@@ -188,10 +203,11 @@ pub fn repair(state: &mut PluginState) -> StateRepairs {
     } else if !repairs.is_empty() {
         nice_warn!(
             "Javari: state repaired: defaults for {:?} (missing or of the wrong kind), clamped \
-             to range {:?}, unknown IDs dropped {:?}",
+             to range {:?}, unknown IDs dropped {:?}, withdrawn choices migrated {:?}",
             repairs.defaulted,
             repairs.clamped,
-            repairs.dropped
+            repairs.dropped,
+            repairs.migrated
         );
     }
     repairs
@@ -439,6 +455,36 @@ mod tests {
         );
         assert!(!params.thread_enabled.value());
         assert_eq!(params.bridge_stiffness_log10.value(), 9.25);
+    }
+
+    /// A state saved while the draft tier existed loads with the live tier, said as a repair; the
+    /// plugin's quality IDs are the core's tier names, which the migration relies on.
+    #[test]
+    fn a_state_with_the_withdrawn_draft_tier_loads_as_live() {
+        let mut state = default_state();
+        state.params.insert(
+            QUALITY_ID.to_string(),
+            ParamValue::String("draft".to_string()),
+        );
+        let repairs = repair(&mut state);
+        assert_eq!(repairs.migrated, [QUALITY_ID]);
+        assert!(repairs.defaulted.is_empty(), "{repairs:?}");
+        assert_eq!(text(&state.params[QUALITY_ID]), r#"String("live")"#);
+
+        let params = JavariParams::default();
+        restore(&params, &state_bytes("\"qual\":{\"string\":\"draft\"}")).unwrap();
+        assert_eq!(params.quality.value(), crate::params::QualityChoice::Live);
+        for quality in Quality::ALL {
+            let params = JavariParams::default();
+            let bytes = state_bytes(&format!("\"qual\":{{\"string\":\"{}\"}}", quality.name()));
+            restore(&params, &bytes).unwrap();
+            assert_eq!(
+                params.quality.value().quality(),
+                quality,
+                "{}",
+                quality.name()
+            );
+        }
     }
 
     #[test]

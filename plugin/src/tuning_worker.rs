@@ -208,7 +208,7 @@ mod tests {
     #[test]
     fn a_plucked_note_comes_back_calibrated() {
         let mut settings = EngineSettings::default();
-        settings.voice.quality = Quality::Draft;
+        settings.voice.quality = Quality::Live;
         let mut engine = Engine::new(&settings, 44_100.0, 2);
         let worker = TuningWorker::start();
         let mut output = [0.0f32; 64];
@@ -241,7 +241,7 @@ mod tests {
     #[test]
     fn a_changed_bridge_comes_back_tuned() {
         let mut settings = EngineSettings::default();
-        settings.voice.quality = Quality::Draft;
+        settings.voice.quality = Quality::Live;
         settings.tuning.as_played = false;
         let mut engine = Engine::new(&settings, 44_100.0, 4);
         engine.prepare_tunings();

@@ -219,12 +219,8 @@ impl SettingChange {
             }
             // The cheaper tiers only: Reference costs a second per input.
             SettingChange::Quality(index) => {
-                voice.quality = [
-                    Quality::Draft,
-                    Quality::Live,
-                    Quality::Fine,
-                    Quality::Studio,
-                ][usize::from(index) % 4]
+                voice.quality =
+                    [Quality::Live, Quality::Fine, Quality::Studio][usize::from(index) % 3]
             }
             SettingChange::PluckPosition(value) => {
                 settings.pluck.position_m = value.scaled(0.05, 0.6)
@@ -363,7 +359,7 @@ enum Operation {
 pub fn engine_events(bytes: &[u8]) {
     let mut input = Unstructured::new(bytes);
     let mut settings = EngineSettings::default();
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     let Ok(initial) = Vec::<SettingChange>::arbitrary(&mut input) else {
         return;
     };

@@ -289,7 +289,7 @@ fn clap_automation_is_allocation_free_and_keeps_the_string_in_tune() {
         (6_000, thread, 0.0),
         (8_000, quality, 3.0), // Reference
         (9_000, thread, 1.0),
-        (10_000, quality, 0.0), // Draft
+        (10_000, quality, 0.0), // Live
         (12_000, stiffness, 8.0),
         (12_001, position, 40.0),
     ];
@@ -472,7 +472,6 @@ fn clap_latency_follows_the_tier_through_a_restart() {
     );
     assert_eq!(engine_latency(Quality::Live), 0);
     assert_eq!(engine_latency(Quality::Fine), 0);
-    assert_eq!(engine_latency(Quality::Draft), 0);
 
     let rate = 44_100.0;
     play(&mut instance, rate, 64, 57, 0.5, 0, 0.02);
@@ -486,15 +485,13 @@ fn clap_latency_follows_the_tier_through_a_restart() {
         "fine, the default"
     );
     assert_eq!(changes(&instance), 0);
-    // (CLAP plain value of an enum parameter: its index. Draft 0, live 1, fine 2, studio 3,
-    // reference 4.)
+    // (CLAP plain value of an enum parameter: its index. Live 0, fine 1, studio 2, reference 3.)
     let tiers = [
-        (3.0, Quality::Studio),
-        (4.0, Quality::Reference),
-        (1.0, Quality::Live),
-        (2.0, Quality::Fine),
-        (0.0, Quality::Draft),
-        (4.0, Quality::Reference),
+        (2.0, Quality::Studio),
+        (3.0, Quality::Reference),
+        (0.0, Quality::Live),
+        (1.0, Quality::Fine),
+        (3.0, Quality::Reference),
     ];
     for (index, tier) in tiers {
         let before = latency.get(&instance.plugin_handle());

@@ -493,13 +493,12 @@ fn vst3_latency_follows_the_tier_through_a_restart() {
     assert!(!latency_restart(), "a restart at the default tier");
     assert_eq!(latency(), 0, "fine, the default");
 
-    // Normalised enum values: draft 0, live 1/4, fine 1/2, studio 3/4, reference 1.
+    // Normalised enum values: live 0, fine 1/3, studio 2/3, reference 1.
     for (tier, value) in [
-        (Quality::Studio, 0.75),
+        (Quality::Studio, 2.0 / 3.0),
         (Quality::Reference, 1.0),
-        (Quality::Live, 0.25),
-        (Quality::Fine, 0.5),
-        (Quality::Draft, 0.0),
+        (Quality::Live, 0.0),
+        (Quality::Fine, 1.0 / 3.0),
         (Quality::Reference, 1.0),
     ] {
         let before = latency();

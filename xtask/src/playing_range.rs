@@ -22,9 +22,7 @@
 
 use crate::calibration_cache::{calibration, core_version, workspace, CalibrationCache};
 use javari_core::analysis::cents;
-use javari_core::analysis::listening::{
-    compare, sustained_pitch_hz, ListeningDifference, LOW_BANDS_TO_HZ,
-};
+use javari_core::analysis::listening::{compare, sustained_pitch_hz, ListeningDifference};
 use javari_core::analysis::playing_range::{
     calibration_request, full_grid, render_as_played, settings_for, GridPoint, CREST_KEYS, KEYS,
     NOTE_SECONDS, PLUCK_POSITIONS_M, VELOCITIES,
@@ -92,9 +90,6 @@ impl TierOverGrid {
     }
     pub fn band_level_db(&self) -> Spread {
         self.spread(|d| d.band_level_db)
-    }
-    pub fn low_band_level_db(&self) -> Spread {
-        self.spread(|d| d.low_band_level_db)
     }
     pub fn centroid_error(&self) -> Spread {
         self.spread(|d| d.centroid_error)
@@ -350,7 +345,6 @@ pub fn measure(tiers: &[Quality], sample_rate_hz: f64) -> Vec<TierOverGrid> {
                     sustained_cents: cents(pitch, nominal),
                     glide_cents: 0.0,
                     band_level_db: 0.0,
-                    low_band_level_db: 0.0,
                     centroid_error: 0.0,
                 };
                 (grid[i], difference)
@@ -411,28 +405,6 @@ pub fn to_markdown(results: &[TierOverGrid]) -> String {
             pitch.median
         );
     }
-    let _ = write!(
-        text,
-        "\nIn the band the draft tier keeps (1/6-octave bands below {:.0} kHz, its highest mode), \
-         band levels against the reference, worst / median:",
-        LOW_BANDS_TO_HZ / 1e3
-    );
-    for tier in results
-        .iter()
-        .filter(|t| t.tier != Quality::Reference.name())
-    {
-        let low = tier.low_band_level_db();
-        let _ = write!(
-            text,
-            " {} {:.1} / {:.1} dB ({});",
-            tier.tier,
-            low.worst,
-            low.median,
-            low.worst_at.label()
-        );
-    }
-    text.pop();
-    text.push_str(".\n");
     text.push_str(&away_from_the_crest_markdown(results));
     text
 }
@@ -484,9 +456,7 @@ fn away_from_the_crest_markdown(results: &[TierOverGrid]) -> String {
 }
 
 /// Rows for the targets table: the live, fine (the default) and studio tiers' worst grid points
-/// against issue 15's targets (sustained pitch 1 cent, band levels 5 dB, centroid 15 %), and the
-/// draft tier's own
-/// (sustained pitch 1 cent, band levels below its highest mode 5 dB).
+/// against issue 15's targets (sustained pitch 1 cent, band levels 5 dB, centroid 15 %).
 pub fn target_rows(results: &[TierOverGrid]) -> Vec<(String, f64, f64, &'static str)> {
     let mut rows = Vec::new();
     for tier in results.iter().filter(|t| {
@@ -522,26 +492,6 @@ pub fn target_rows(results: &[TierOverGrid]) -> Vec<(String, f64, f64, &'static 
             " %",
         ));
     }
-    // The draft tier keeps the modes below 10 kHz, for speed: in tune, and like the reference
-    // in the band it keeps (its whole-band levels and centroid are in the grid's table).
-    for tier in results.iter().filter(|t| t.tier == Quality::Draft.name()) {
-        rows.push((
-            "draft tier, worst pluck of the range: sustained pitch within 1 cent".to_string(),
-            tier.sustained_cents().worst,
-            1.0,
-            " cents",
-        ));
-        rows.push((
-            format!(
-                "draft tier, worst pluck of the range: band levels below {:.0} kHz (its highest \
-                 mode) within 5 dB RMS",
-                LOW_BANDS_TO_HZ / 1e3
-            ),
-            tier.low_band_level_db().worst,
-            5.0,
-            " dB",
-        ));
-    }
     rows
 }
 
@@ -554,7 +504,7 @@ pub fn to_json_rows(results: &[TierOverGrid]) -> Vec<String> {
                 format!(
                     "{{\"tier\": \"{}\", \"key\": {}, \"velocity\": {}, \"pluck_position_m\": {}, \
                      \"sustained_cents\": {:.4}, \"glide_cents\": {:.4}, \"band_level_db\": {:.4}, \
-                     \"low_band_level_db\": {:.4}, \"centroid_error\": {:.5}}}",
+                     \"centroid_error\": {:.5}}}",
                     tier.tier,
                     point.key,
                     point.velocity,
@@ -562,7 +512,6 @@ pub fn to_json_rows(results: &[TierOverGrid]) -> Vec<String> {
                     d.sustained_cents,
                     d.glide_cents,
                     d.band_level_db,
-                    d.low_band_level_db,
                     d.centroid_error
                 )
             })
@@ -587,38 +536,36 @@ mod tests {
             sustained_cents: cents,
             glide_cents: cents.abs(),
             band_level_db,
-            low_band_level_db: band_level_db,
             centroid_error: 0.1,
         }
     }
 
     #[test]
-    fn the_draft_tier_is_held_to_its_own_targets() {
-        let draft = TierOverGrid {
-            tier: Quality::Draft.name(),
+    fn the_modal_tiers_are_held_to_issue_15s_targets() {
+        let live = TierOverGrid {
+            tier: Quality::Live.name(),
             points: vec![
                 (point(51, 1), difference(10.9, 19.6)),
                 (point(60, 127), difference(0.2, 9.7)),
             ],
         };
-        let rows = target_rows(&[draft]);
+        let rows = target_rows(&[live]);
         let targets: Vec<(&str, f64, f64)> = rows
             .iter()
             .map(|(target, measured, goal, _)| (target.as_str(), *measured, *goal))
             .collect();
-        assert_eq!(targets.len(), 2, "{targets:?}");
-        assert!(targets[0].0.contains("draft tier") && targets[0].0.contains("1 cent"));
+        assert_eq!(targets.len(), 3, "{targets:?}");
+        assert!(targets[0].0.contains("live tier") && targets[0].0.contains("1 cent"));
         assert_eq!((targets[0].1, targets[0].2), (10.9, 1.0));
-        assert!(targets[1].0.contains("below 10 kHz"));
+        assert!(targets[1].0.contains("band levels within 5 dB"));
         assert_eq!((targets[1].1, targets[1].2), (19.6, 5.0));
-        let table = to_markdown(&[TierOverGrid {
-            tier: Quality::Draft.name(),
+        assert!(targets[2].0.contains("centroid within 15 %"));
+        // The reference's own row has no targets.
+        let reference = TierOverGrid {
+            tier: Quality::Reference.name(),
             points: vec![(point(60, 127), difference(0.2, 9.7))],
-        }]);
-        assert!(
-            table.contains("draft 9.7 / 9.7 dB (key 60, velocity 127, pluck at 0.20 m)."),
-            "{table}"
-        );
+        };
+        assert!(target_rows(&[reference]).is_empty());
     }
 
     #[test]

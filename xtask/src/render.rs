@@ -930,7 +930,7 @@ mod tests {
             score.note(0.02 * index as f64, 0.2, note, 0.9);
         }
         let mut settings = EngineSettings::default();
-        settings.voice.quality = Quality::Draft;
+        settings.voice.quality = Quality::Live;
         let options = RenderOptions {
             tail_s: 0.1,
             block_size: 256,
@@ -974,7 +974,7 @@ mod tests {
             score.note(1.0 + index as f64, 0.5, note, 0.8);
         }
         let mut settings = EngineSettings::default();
-        settings.voice.quality = Quality::Draft;
+        settings.voice.quality = Quality::Live;
         let directory = tempfile::tempdir().unwrap();
         let cache = CalibrationCache::at(directory.path().to_path_buf(), "test");
         let options = RenderOptions::default();
@@ -1005,7 +1005,7 @@ mod tests {
             score.note(0.05 * index as f64, 0.2, note, 0.8);
         }
         let mut settings = EngineSettings::default();
-        settings.voice.quality = Quality::Draft;
+        settings.voice.quality = Quality::Live;
         let options = RenderOptions {
             tail_s: 0.05,
             ..RenderOptions::default()
@@ -1073,7 +1073,7 @@ mod tests {
             "--out".to_string(),
             out.display().to_string(),
             "--quality".to_string(),
-            "draft".to_string(),
+            "live".to_string(),
             "--tail-seconds".to_string(),
             "0.1".to_string(),
             "--jobs".to_string(),
@@ -1081,6 +1081,18 @@ mod tests {
         ];
         line.extend(extra.iter().map(|arg| arg.to_string()));
         RenderArgs::try_parse_from(line).unwrap()
+    }
+
+    /// The withdrawn draft tier is refused by name, with the tiers there are.
+    #[test]
+    fn the_withdrawn_draft_tier_is_refused_with_the_tiers_there_are() {
+        let error = RenderArgs::try_parse_from(["render", "--quality", "draft"]).unwrap_err();
+        let message = error.to_string();
+        assert!(message.contains("'draft'"), "{message}");
+        assert!(
+            message.contains("live, fine, studio, reference"),
+            "{message}"
+        );
     }
 
     #[test]

@@ -56,7 +56,7 @@ pub struct SoakArgs {
     /// Seed of the scene's randomness (the same seed plays the same scene).
     #[arg(long, value_name = "S", default_value_t = 1)]
     seed: u64,
-    /// Quality tier: draft, live, fine (the plugin's default), studio or reference.
+    /// Quality tier: live, fine (the plugin's default), studio or reference.
     #[arg(long, value_name = "TIER", default_value = "fine", value_parser = quality_name)]
     quality: Quality,
     /// Automate the quality tier too (switches among all four tiers).
@@ -73,7 +73,7 @@ pub struct SoakArgs {
 
 fn quality_name(text: &str) -> Result<Quality, String> {
     Quality::from_name(text.trim())
-        .ok_or_else(|| format!("`{text}` is not a tier: draft, live, fine, studio or reference"))
+        .ok_or_else(|| format!("`{text}` is not a tier: live, fine, studio or reference"))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -932,7 +932,7 @@ mod tests {
     /// Every tier survives the automated scene, tier switches included.
     #[test]
     fn tier_automation_stays_finite() {
-        let mut scene = SoakScene::new(3, Quality::Draft, true, CHANGES_PER_SECOND);
+        let mut scene = SoakScene::new(3, Quality::Live, true, CHANGES_PER_SECOND);
         run_scene(&mut scene, 2.0, 2.0, |_, _| {});
         assert_eq!(scene.counts.allocations, 0);
         assert_eq!(scene.counts.non_finite_samples, 0);

@@ -14,9 +14,7 @@
 //! - **band levels**: 1/6-octave band levels (dB) from 40 Hz to 16 kHz or 0.99 of the Nyquist
 //!   frequency, in 4096-sample frames; two renders differ by the RMS of their level differences
 //!   over the bands within 60 dB of the reference frame's loudest, a band the other render leaves
-//!   below that floor counting as the floor, averaged over frames; the same over the bands below
-//!   10 kHz alone measures a tier that keeps only the modes below it (the draft tier) in the band
-//!   it keeps;
+//!   below that floor counting as the floor, averaged over frames;
 //! - **centroid course**: the power-weighted mean frequency above 5.5 f₀ (where the jawari's
 //!   formant moves; up to 15 kHz) in each frame; two renders differ by the mean relative
 //!   difference over the frames where the reference sounds.
@@ -41,10 +39,6 @@ pub const BAND_FLOOR_DB: f64 = 60.0;
 /// The centroid is taken above this multiple of the fundamental.
 pub const CENTROID_FROM_PARTIAL: f64 = 5.5;
 pub const CENTROID_TO_HZ: f64 = 15_000.0;
-/// The top of the low bands' measure, Hz: the draft tier's highest mode (it keeps the modes
-/// below 10 kHz), so that a tier which drops the top octave by design is measured in the band it
-/// keeps.
-pub const LOW_BANDS_TO_HZ: f64 = 10_000.0;
 
 /// How far a render lies from the reference render of the same pluck.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,8 +49,6 @@ pub struct ListeningDifference {
     pub glide_cents: f64,
     /// Fractional-octave band levels, RMS difference, dB.
     pub band_level_db: f64,
-    /// The same over the bands below [`LOW_BANDS_TO_HZ`] only, dB.
-    pub low_band_level_db: f64,
     /// Centroid course, mean relative difference (0.1 = 10 %).
     pub centroid_error: f64,
 }
@@ -201,16 +193,6 @@ pub fn compare(
         band_levels_db(reference, sample_rate_hz),
     );
     let band_level_db = band_level_distance_db(&levels, &reference_levels);
-    let low_bands = band_edges_hz(sample_rate_hz)
-        .windows(2)
-        .take_while(|band| band[1] <= LOW_BANDS_TO_HZ)
-        .count();
-    let low = |rows: &[Vec<f64>]| -> Vec<Vec<f64>> {
-        rows.iter()
-            .map(|row| row[..low_bands.min(row.len())].to_vec())
-            .collect()
-    };
-    let low_band_level_db = band_level_distance_db(&low(&levels), &low(&reference_levels));
     let centroid_error = centroid_course_error(
         &centroid_course_hz(render, sample_rate_hz, reference_pitch),
         &centroid_course_hz(reference, sample_rate_hz, reference_pitch),
@@ -219,7 +201,6 @@ pub fn compare(
         sustained_cents,
         glide_cents,
         band_level_db,
-        low_band_level_db,
         centroid_error,
     }
 }
@@ -251,7 +232,6 @@ mod tests {
         assert_eq!(difference.sustained_cents, 0.0);
         assert_eq!(difference.glide_cents, 0.0);
         assert_eq!(difference.band_level_db, 0.0);
-        assert_eq!(difference.low_band_level_db, 0.0);
         assert_eq!(difference.centroid_error, 0.0);
     }
 
@@ -278,21 +258,6 @@ mod tests {
         assert!(difference.band_level_db > 10.0, "{difference:?}");
         assert!(difference.centroid_error > 0.2, "{difference:?}");
         assert!(difference.sustained_cents.abs() < 0.01, "{difference:?}");
-    }
-
-    /// The draft tier keeps its modes below 10 kHz: the low bands' measure sees what it keeps,
-    /// the whole band's what it drops too.
-    #[test]
-    fn the_low_bands_leave_out_what_lies_above_10_khz() {
-        // Partials of 500 Hz: the reference's reach 15 kHz, the render's stop at 9 kHz.
-        let reference = tone(500.0, 30, 1.0);
-        let band_limited = tone(500.0, 18, 1.0);
-        let difference = compare(&band_limited, &reference, RATE, 500.0);
-        assert!(difference.band_level_db > 10.0, "{difference:?}");
-        assert!(difference.low_band_level_db < 0.5, "{difference:?}");
-        // Dropping a partial below 10 kHz counts in the low bands.
-        let dull = tone(500.0, 12, 1.0);
-        assert!(compare(&dull, &reference, RATE, 500.0).low_band_level_db > 5.0);
     }
 
     #[test]

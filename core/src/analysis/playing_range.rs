@@ -187,7 +187,7 @@ mod tests {
             velocity: 80,
             pluck_position_m: 0.35,
         };
-        let output = render(Quality::Draft, &point, 0.2, 44_100.0);
+        let output = render(Quality::Live, &point, 0.2, 44_100.0);
         assert_eq!(output.len(), 8820);
         assert!(output.iter().all(|x| x.is_finite()));
         assert!(output.iter().any(|x| x.abs() > 1e-4));

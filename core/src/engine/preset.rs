@@ -19,7 +19,7 @@
 //! | `eta_s` | s | 0–1e-6 | frequency-dependent loss η |
 //! | `nut_pickup_weight` | 1 | 0–1 | with output pickup: 1: nut force, 0: bridge force |
 //! | `tanpura_output` | text | pickup, radiated | the pickup forces, or the body's radiated sound |
-//! | `quality` | text | draft, live, fine, studio, reference | speed against accuracy (`quality.rs`) |
+//! | `quality` | text | live, fine, studio, reference | speed against accuracy (`quality.rs`); `draft`, a tier withdrawn in stop 62, reads as live |
 //! | `pluck_position_m` | m | 0.05–0.6 | pluck point from the tuning bead |
 //! | `pluck_width_m` | m | 0.002–0.040 | fingertip width |
 //! | `pluck_amplitude_m` | m | 0–0.005 | finger lift at full velocity |
@@ -75,7 +75,7 @@ use toml::Spanned;
 pub const PLUCK_POSITION_RANGE_M: (f64, f64) = (0.05, 0.6);
 
 /// Names of the quality tiers, as written in presets ([`Quality::name`]).
-pub const QUALITY_NAMES: [&str; 5] = ["draft", "live", "fine", "studio", "reference"];
+pub const QUALITY_NAMES: [&str; 4] = ["live", "fine", "studio", "reference"];
 
 /// Names of the instruments, bowed models and bowed strings, as written in presets.
 pub const INSTRUMENT_NAMES: [&str; 2] = ["tanpura", "bowed"];
@@ -498,7 +498,15 @@ impl Preset {
             };
         }
         let voice = &mut settings.voice;
-        if let Some(name) = check.choice("quality", read.quality)? {
+        // A preset saved while a withdrawn tier existed names it: it plays the tier that took its
+        // place (`Quality::withdrawn`).
+        let withdrawn = read
+            .quality
+            .as_ref()
+            .and_then(|name| Quality::withdrawn(name.get_ref()));
+        if let Some(quality) = withdrawn {
+            voice.quality = quality;
+        } else if let Some(name) = check.choice("quality", read.quality)? {
             voice.quality = Quality::from_name(name).expect("QUALITY_NAMES are the tiers' names");
         }
         set(
@@ -820,7 +828,7 @@ mod tests {
             ("thread_enabled = yes", "true or false"),
             (
                 "quality = \"ultra\"",
-                "\"draft\", \"live\", \"fine\", \"studio\", \"reference\"",
+                "\"live\", \"fine\", \"studio\", \"reference\"",
             ),
             ("gamma_per_s = fast", "a number from 0 to 20"),
             ("bridge_stifness = 1e8", "a known key"),
@@ -881,6 +889,15 @@ mod tests {
             .collect();
         let expected: Vec<&str> = KEYS.iter().map(|(key, _)| *key).collect();
         assert_eq!(keys, expected);
+    }
+
+    /// A preset saved while the draft tier existed loads with the live tier that replaced it,
+    /// and is written back with live's name.
+    #[test]
+    fn a_preset_naming_the_withdrawn_draft_tier_loads_as_live() {
+        let parsed = Preset::parse("name = \"old\"\nquality = \"draft\"\n", "old.toml").unwrap();
+        assert_eq!(parsed.settings.voice.quality, Quality::Live);
+        assert!(parsed.to_text().contains("quality = \"live\""));
     }
 
     #[test]

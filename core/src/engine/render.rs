@@ -383,7 +383,7 @@ mod tests {
             score.note(0.01 * index as f64, 0.1, note, 0.9);
         }
         let mut settings = EngineSettings::default();
-        settings.voice.quality = crate::tanpura::quality::Quality::Draft;
+        settings.voice.quality = crate::tanpura::quality::Quality::Live;
         settings.stereo_width = 1.0;
         let mono_options = RenderOptions {
             tail_s: 0.2,
@@ -414,7 +414,7 @@ mod tests {
             score.note(0.01 * index as f64, 0.1, note, 0.9);
         }
         let mut settings = EngineSettings::default();
-        settings.voice.quality = crate::tanpura::quality::Quality::Draft;
+        settings.voice.quality = crate::tanpura::quality::Quality::Live;
         let options = RenderOptions {
             tail_s: 0.05,
             block_size: 100,
@@ -431,7 +431,7 @@ mod tests {
     #[test]
     fn blocks_stream_the_same_bits_as_the_whole_signal() {
         let mut settings = EngineSettings::default();
-        settings.voice.quality = crate::tanpura::quality::Quality::Draft;
+        settings.voice.quality = crate::tanpura::quality::Quality::Live;
         let mut score = Score::default();
         score.note(0.0, 0.02, 48, 0.9);
         score.push(0.013, ScoreAction::Tempo(90.0));

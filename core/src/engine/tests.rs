@@ -221,13 +221,13 @@ fn quality_change_keeps_ringing_strings_and_applies_from_the_next_pluck() {
     let mut engine = Engine::new(&EngineSettings::default(), RATE, 2);
     run(&mut engine, &[note_on(0, 57)], 2_000);
     let mut settings = EngineSettings::default();
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     engine.set_settings(&settings);
     let after = run(&mut engine, &[], 4_410);
     assert!(peak(&after[4_000..]) > 0.01, "the ringing string goes on");
     assert_eq!(engine.slots[0].voice.settings().quality, Quality::Reference);
     run(&mut engine, &[note_on(0, 57)], 64);
-    assert_eq!(engine.slots[0].voice.settings().quality, Quality::Draft);
+    assert_eq!(engine.slots[0].voice.settings().quality, Quality::Live);
     assert_eq!(
         engine.active_voices(),
         1,
@@ -325,7 +325,7 @@ fn nan_settings_neither_panic_nor_reach_the_output() {
     // Found by the engine_events fuzz target: a NaN pluck width reached `f64::clamp` as a bound
     // and panicked on the audio thread.
     let mut settings = EngineSettings::default();
-    settings.voice.quality = crate::tanpura::quality::Quality::Draft;
+    settings.voice.quality = crate::tanpura::quality::Quality::Live;
     settings.pluck.width_m = f64::NAN;
     settings.pluck.amplitude_m = f64::NAN;
     settings.pluck.position_m = f64::NAN;
@@ -364,7 +364,7 @@ fn nan_settings_neither_panic_nor_reach_the_output() {
 #[test]
 fn each_drone_string_has_its_own_fine_tuning_level_and_thread() {
     let mut settings = EngineSettings::default();
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     settings.drone.enabled = true;
     settings.drone.strings[0] = drone::DroneString {
         fine_tune_cents: -13.0,
@@ -403,7 +403,7 @@ fn each_drone_string_has_its_own_fine_tuning_level_and_thread() {
 fn a_drone_string_at_minus_60_db_is_60_db_quieter() {
     let peak_of_first_string = |level_db: f64| {
         let mut settings = EngineSettings::default();
-        settings.voice.quality = Quality::Draft;
+        settings.voice.quality = Quality::Live;
         settings.drone.enabled = true;
         settings.drone.strings[0].level_db = level_db;
         let mut engine = Engine::new(&settings, RATE, 4);
@@ -419,7 +419,7 @@ fn a_drone_string_at_minus_60_db_is_60_db_quieter() {
 fn a_calibration_retunes_its_string_from_the_next_pluck_and_is_asked_for_once() {
     use crate::tanpura::as_played::{Calibration, NOTE_VELOCITIES};
     let mut settings = EngineSettings::default();
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     let mut engine = Engine::new(&settings, RATE, 2);
     run(&mut engine, &[note_on(0, 57)], 64);
     // Without a calibration the string aims at its note, and the engine asks for one, once.
@@ -479,7 +479,7 @@ fn stereo(engine: &mut Engine, events: &[TimedEvent], samples: usize) -> (Vec<f3
 
 fn radiated_drone(width: f64) -> EngineSettings {
     let mut settings = radiated();
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     settings.drone.enabled = true;
     settings.stereo_width = width;
     settings
@@ -520,7 +520,7 @@ fn the_stereo_mid_is_the_mono_output_and_width_zero_is_two_equal_channels() {
 #[test]
 fn the_first_drone_string_sounds_on_the_left_and_the_last_on_the_right() {
     let mut settings = EngineSettings::default();
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     settings.drone.enabled = true;
     settings.stereo_width = 1.0;
     let mut engine = Engine::new(&settings, RATE, 4);
@@ -547,7 +547,7 @@ fn pluck_four_notes(engine: &mut Engine) {
 #[test]
 fn a_glide_retunes_a_ringing_string_every_other_tick_and_each_reaches_the_target() {
     let mut settings = EngineSettings::default();
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     let mut engine = Engine::new(&settings, RATE, 4);
     pluck_four_notes(&mut engine);
     assert_eq!(engine.active_voices(), 4);
@@ -587,7 +587,7 @@ fn a_glide_retunes_a_ringing_string_every_other_tick_and_each_reaches_the_target
 #[test]
 fn a_drone_sa_set_in_the_settings_plays_without_a_held_note_and_stops_when_unset() {
     let mut settings = EngineSettings::default();
-    settings.voice.quality = Quality::Draft;
+    settings.voice.quality = Quality::Live;
     settings.drone.enabled = true;
     settings.drone.sa_note = Some(50);
     let mut engine = Engine::new(&settings, RATE, 4);

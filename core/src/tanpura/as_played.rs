@@ -63,7 +63,7 @@
 //! two schemes, the FD studio of stops 34–56 settled at +0.25 mm and the reference at +0.30 mm,
 //! and the softest touch (velocity 1) then stayed on the crest in one and not in the other,
 //! 14.8 cents apart; at +0.30 mm both lay within 0.12 cents of each other at every velocity
-//! 1–127 (`examples/as_played.rs`). The draft and live tiers keep their own: their string rests
+//! 1–127 (`examples/as_played.rs`). The live tier keeps its own: its string rests
 //! 7 µm above the crest (`docs/modal-tanpura.md` §8), so the reference's thread would not set
 //! the same contact on it.
 //!
@@ -740,7 +740,7 @@ mod tests {
     #[test]
     fn a_check_tunes_from_the_note_whatever_the_voice_last_rendered() {
         let settings = VoiceSettings {
-            quality: Quality::Draft,
+            quality: Quality::Live,
             ..VoiceSettings::default()
         };
         let nominal = settings.fundamental_hz;

@@ -1,17 +1,21 @@
 //! Quality tiers: which discretisation a tanpura voice runs, and at what resolution.
 //!
-//! - Draft, Live and Fine run the modal scheme (`modal/`, `docs/modal-tanpura.md`): the string's
+//! - Live and Fine run the modal scheme (`modal/`, `docs/modal-tanpura.md`): the string's
 //!   eigenmodes advanced by exact two-pole recursions at the output rate (exact partials and decay
 //!   rates, no oversampling, no decimator, no latency), in f32 over the modes, with the contact
 //!   force on a few points of the bridge and thread solved by Newton in f64. Live keeps the modes
-//!   below 20 kHz, a point every 2 mm of the bridge and every half millimetre of the thread;
-//!   Draft keeps the modes below 10 kHz, with points every 2 mm of the bridge and every
-//!   millimetre of the thread. The string rests on the thread, so the thread's points shape every
-//!   note. The bridge's points matter only where the vibrating string reaches the crest, and
-//!   between points 2 mm apart the bridge's parabola (radius 0.1 m) lies at most 5 µm from its
-//!   chord. Points every 2 mm instead of 1 mm make the live string 17–23 % faster and leave its
-//!   playing-range figures within the measures' own spread: mean changes of 0.01 cents and
-//!   0.05 dB, at most 0.13 cents and 1.4 dB at one pluck (`docs/performance.md`, stop 29).
+//!   below 20 kHz, a point every 2 mm of the bridge and every half millimetre of the thread. The
+//!   string rests on the thread, so the thread's points shape every note. The bridge's points
+//!   matter only where the vibrating string reaches the crest, and between points 2 mm apart the
+//!   bridge's parabola (radius 0.1 m) lies at most 5 µm from its chord. Points every 2 mm instead
+//!   of 1 mm make the live string 17–23 % faster and leave its playing-range figures within the
+//!   measures' own spread: mean changes of 0.01 cents and 0.05 dB, at most 0.13 cents and 1.4 dB
+//!   at one pluck (`docs/performance.md`, stop 29).
+//! - The draft tier (live's scheme with the modes below 10 kHz and the thread's points every
+//!   millimetre) was withdrawn in stop 62: its bridge never fed the upper band, at any key
+//!   measured, so it played no jawari (`docs/modal-tanpura.md` §14), and the signature tests
+//!   that hold every other modal tier could not hold it. A preset or a saved plugin state that
+//!   names it plays live ([`Quality::withdrawn`]).
 //! - Fine runs the modal scheme on the reference's own grid (`docs/modal-tanpura.md` §10–11): every
 //!   mode of the seed's FD grid (N = 200, the 199 sampled sines with the frequencies and decays
 //!   of its trapezoidal rule at 4× the output rate), advanced exactly at the output rate, with the
@@ -54,10 +58,9 @@ use crate::newton::NewtonSettings;
 use crate::tanpura::fd::SolverKind;
 use crate::tanpura::modal::GridModes;
 
-/// The five tiers, cheapest first; Fine is the plugin's default.
+/// The four tiers, cheapest first; Fine is the plugin's default.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Quality {
-    Draft,
     Live,
     #[default]
     Fine,
@@ -137,8 +140,7 @@ const TIER_NEWTON: NewtonSettings = NewtonSettings {
 };
 
 impl Quality {
-    pub const ALL: [Quality; 5] = [
-        Quality::Draft,
+    pub const ALL: [Quality; 4] = [
         Quality::Live,
         Quality::Fine,
         Quality::Studio,
@@ -147,14 +149,6 @@ impl Quality {
 
     pub fn tier(self) -> Tier {
         match self {
-            Quality::Draft => Tier::Modal(ModalTier {
-                highest_mode_hz: 10_000.0,
-                bridge_point_spacing_m: 2e-3,
-                thread_point_spacing_m: 1e-3,
-                newton: TIER_NEWTON,
-                grid_modes: false,
-                oversample: 1,
-            }),
             Quality::Live => Tier::Modal(ModalTier {
                 highest_mode_hz: 20_000.0,
                 bridge_point_spacing_m: 2e-3,
@@ -208,7 +202,6 @@ impl Quality {
 
     pub fn name(self) -> &'static str {
         match self {
-            Quality::Draft => "draft",
             Quality::Live => "live",
             Quality::Fine => "fine",
             Quality::Studio => "studio",
@@ -222,7 +215,20 @@ impl Quality {
             .into_iter()
             .find(|quality| quality.name() == name)
     }
+
+    /// The tier that plays a withdrawn tier's name ([`WITHDRAWN_TIERS`]) where a file saved by an
+    /// earlier version holds it (a preset, the plugin's state); `None` for any other name.
+    pub fn withdrawn(name: &str) -> Option<Quality> {
+        WITHDRAWN_TIERS
+            .into_iter()
+            .find_map(|(withdrawn, quality)| (withdrawn == name).then_some(quality))
+    }
 }
+
+/// Tiers withdrawn from the instrument, by the name files saved before then hold, with the tier
+/// that plays them now. Draft (stop 62): live's scheme on fewer modes, without the jawari; live
+/// is the cheapest tier that plays it.
+pub const WITHDRAWN_TIERS: [(&str, Quality); 1] = [("draft", Quality::Live)];
 
 #[cfg(test)]
 mod tests {
@@ -252,14 +258,23 @@ mod tests {
     }
 
     #[test]
-    fn fast_tiers_are_modal_and_draft_resolves_less_than_live() {
-        let draft = Quality::Draft.modal_tier().unwrap();
-        let live = Quality::Live.modal_tier().unwrap();
-        assert!(draft.highest_mode_hz < live.highest_mode_hz);
-        assert!(draft.bridge_point_spacing_m >= live.bridge_point_spacing_m);
-        assert!(draft.thread_point_spacing_m > live.thread_point_spacing_m);
+    fn fast_tiers_are_modal_at_the_output_rate() {
+        assert!(Quality::Live.modal_tier().is_some());
+        assert!(Quality::Fine.modal_tier().is_some());
         assert_eq!(Quality::Live.oversample(), 1);
         assert_eq!(Quality::Fine.oversample(), 1);
+    }
+
+    /// A file saved while the draft tier existed loads with the live tier, and the withdrawn
+    /// name is no tier's name today (so nothing writes it again).
+    #[test]
+    fn the_withdrawn_draft_tier_reads_as_live() {
+        assert_eq!(Quality::from_name("draft"), None);
+        assert_eq!(Quality::withdrawn("draft"), Some(Quality::Live));
+        for quality in Quality::ALL {
+            assert!(Quality::withdrawn(quality.name()).is_none());
+        }
+        assert_eq!(Quality::withdrawn("ultra"), None);
     }
 
     /// The studio tier is the fine tier's string (its grid modes with the poles of the

@@ -1,6 +1,6 @@
 //! The string of one quality tier, whichever its discretisation: the seed's FD scheme
-//! ([`FdString`], studio and reference) or the modal scheme ([`ModalString`] in f32, draft and
-//! live). A plain enum, so the voice dispatches with one branch per call and no allocation or
+//! ([`FdString`], the reference) or the modal scheme ([`ModalString`] in f32: live, fine and
+//! studio). A plain enum, so the voice dispatches with one branch per call and no allocation or
 //! indirection on the audio thread; everything the voice, the engine and the tests read of a
 //! string is here.
 

@@ -2,7 +2,7 @@
 //!
 //! A voice holds one string per quality tier (`quality.rs`), all built up front, so switching
 //! tiers never allocates; only the selected tier's string is computed, and switching starts it
-//! at rest. The draft, live and fine tiers run the modal scheme ([`ModalString`], at the output
+//! at rest. The live and fine tiers run the modal scheme ([`ModalString`], at the output
 //! rate, no latency), the studio tier the fine tier's modal string at the reference's step, and
 //! the reference the seed's FD scheme ([`FdString`]), both at 4 × the output rate (seed 000:
 //! 4 × 44.1 kHz); an oversampled tier is brought down by a Kaiser-windowed FIR (`decimator.rs`).

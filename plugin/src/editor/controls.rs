@@ -193,7 +193,7 @@ pub fn parameter_groups(ui: &mut egui::Ui, params: &JavariParams, setter: &Param
         });
         group(ui, "Quality", |ui| {
             row(ui, setter, &params.quality,
-                "How the string is simulated. Draft and Live: the string's exact modes at the output rate with contact on a few points (fastest). Fine, the default: the modes and contact points of the seed's own grid, at the output rate. Studio: the fine string stepped four times per sample, as the seed steps it (nearest the reference, about three times Fine's CPU). Reference: the seed's finite-difference scheme itself at 4x oversampling (the most CPU; watch the load meter above).");
+                "How the string is simulated. Live: the string's exact modes at the output rate with contact on a few points (fastest; for many voices on a slow machine). Fine, the default: the modes and contact points of the seed's own grid, at the output rate. Studio: the fine string stepped four times per sample, as the seed steps it (nearest the reference, about three times Fine's CPU). Reference: the seed's finite-difference scheme itself at 4x oversampling (the most CPU; watch the load meter above).");
         });
         group(ui, "Output", |ui| {
             row(ui, setter, &params.tanpura_output,
