@@ -14,15 +14,12 @@
 //! - `grid`: the bench's 180 plucks of the playing range against the reference tuned the same
 //!   way (`analysis::listening::compare`), worst and median (minutes on two cores).
 
-use javari_core::analysis::listening::{
-    centroid_course_error, centroid_course_hz, compare, ListeningDifference,
-};
+use javari_core::analysis::listening::{compare, one_string_errors, ListeningDifference};
 use javari_core::analysis::playing_range::{full_grid, GridPoint, NOTE_SECONDS};
 use javari_core::analysis::precursor::fold_precursor;
 use javari_core::analysis::refined::{
     grid_pluck, grid_render_linearised, modal_variant_pluck, ModalVariant,
 };
-use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::tanpura::excitation::Pluck;
 use javari_core::tanpura::quality::Quality;
 use javari_core::tanpura::{TanpuraVoice, VoiceSettings};
@@ -124,7 +121,6 @@ fn one_string(specs: &[Spec]) {
     let reference =
         Spec::Tier(Quality::Reference).render(&settings, &Pluck::default(), ONE_STRING_SECONDS);
     let f0 = settings.fundamental_hz;
-    let theirs = first_partials_hz(&reference, RATE, f0, 10);
     for spec in specs {
         let mut fastest = f64::INFINITY;
         let mut output = Vec::new();
@@ -133,20 +129,11 @@ fn one_string(specs: &[Spec]) {
             output = spec.render(&settings, &Pluck::default(), ONE_STRING_SECONDS);
             fastest = fastest.min(started.elapsed().as_secs_f64());
         }
-        let cents_error = first_partials_hz(&output, RATE, f0, 10)
-            .iter()
-            .zip(&theirs)
-            .map(|(a, b)| cents(*a, *b).abs())
-            .fold(0.0, f64::max);
-        let formant = centroid_course_error(
-            &centroid_course_hz(&output, RATE, f0),
-            &centroid_course_hz(&reference, RATE, f0),
-        );
+        let (cents_error, distance, formant) = one_string_errors(&output, f0, &reference, f0, RATE);
         println!(
-            "{}: {:.1}x real time, {cents_error:.2} cents, {:.1} dB, formant {:.1} %",
+            "{}: {:.1}x real time, {cents_error:.2} cents, {distance:.1} dB, formant {:.1} %",
             spec.label(),
             ONE_STRING_SECONDS / fastest,
-            third_octave_distance_db(&output, &reference, RATE),
             100.0 * formant
         );
     }

@@ -25,9 +25,8 @@ use crate::calibration_cache::CalibrationCache;
 use crate::playing_range::{self, TierOverGrid};
 use crate::render::render_on;
 use clap::Parser;
-use javari_core::analysis::listening::{centroid_course_error, centroid_course_hz};
+use javari_core::analysis::listening::one_string_errors;
 use javari_core::analysis::refined::{refined_reference_pluck, RefinedRender};
-use javari_core::analysis::{cents, first_partials_hz, third_octave_distance_db};
 use javari_core::bowed::{BowTableString, BowedCapacity, BowedString, BowedVoice, StringConstants};
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::engine::render::{rendered_length, RenderOptions, Score};
@@ -346,29 +345,15 @@ fn measure_best(
     best
 }
 
-/// The one-string measures of `output` (fundamental `fundamental_hz`) against `yardstick`
-/// (`yardstick_hz`): the largest cents error of the first ten partials, the third-octave
-/// spectral distance (dB) and the formant measure of the playing-range grid (listening.rs), each
-/// render at its own f₀.
+/// The one-string measures of `output` against `yardstick` at the bench's rate
+/// ([`one_string_errors`]).
 fn errors_against(
     output: &[f64],
     fundamental_hz: f64,
     yardstick: &[f64],
     yardstick_hz: f64,
 ) -> (f64, f64, f64) {
-    let mine = first_partials_hz(output, SAMPLE_RATE, fundamental_hz, 10);
-    let theirs = first_partials_hz(yardstick, SAMPLE_RATE, yardstick_hz, 10);
-    let cents_error = mine
-        .iter()
-        .zip(&theirs)
-        .map(|(a, b)| cents(*a, *b).abs())
-        .fold(0.0, f64::max);
-    let distance = third_octave_distance_db(output, yardstick, SAMPLE_RATE);
-    let formant = centroid_course_error(
-        &centroid_course_hz(output, SAMPLE_RATE, fundamental_hz),
-        &centroid_course_hz(yardstick, SAMPLE_RATE, yardstick_hz),
-    );
-    (cents_error, distance, formant)
+    one_string_errors(output, fundamental_hz, yardstick, yardstick_hz, SAMPLE_RATE)
 }
 
 fn compare_with_reference(result: &mut BenchResult, reference: &BenchResult) {

@@ -19,7 +19,10 @@
 //!   formant moves; up to 15 kHz) in each frame; two renders differ by the mean relative
 //!   difference over the frames where the reference sounds.
 
-use super::{band_power, cents, peak_frequency_hz, power_spectrum, spectral_centroid_hz};
+use super::{
+    band_power, cents, first_partials_hz, peak_frequency_hz, power_spectrum, spectral_centroid_hz,
+    third_octave_distance_db,
+};
 
 /// Where the sustained pitch is measured, seconds after the pluck.
 pub const SUSTAIN_WINDOW_S: (f64, f64) = (0.3, 1.5);
@@ -168,6 +171,32 @@ pub fn centroid_course_error(course: &[f64], reference: &[f64]) -> f64 {
         .map(|(x, r)| (*x, *r))
         .collect();
     pairs.iter().map(|(x, r)| (x - r).abs() / r).sum::<f64>() / pairs.len().max(1) as f64
+}
+
+/// The bench's one-string measures of `output` (fundamental `fundamental_hz`) against
+/// `yardstick` (`yardstick_hz`), both at `sample_rate_hz`: the largest cents error of the first
+/// ten partials, the third-octave spectral distance (dB) and the centroid course's error (a
+/// fraction), each render at its own f₀.
+pub fn one_string_errors(
+    output: &[f64],
+    fundamental_hz: f64,
+    yardstick: &[f64],
+    yardstick_hz: f64,
+    sample_rate_hz: f64,
+) -> (f64, f64, f64) {
+    let mine = first_partials_hz(output, sample_rate_hz, fundamental_hz, 10);
+    let theirs = first_partials_hz(yardstick, sample_rate_hz, yardstick_hz, 10);
+    let cents_error = mine
+        .iter()
+        .zip(&theirs)
+        .map(|(a, b)| cents(*a, *b).abs())
+        .fold(0.0, f64::max);
+    let distance = third_octave_distance_db(output, yardstick, sample_rate_hz);
+    let formant = centroid_course_error(
+        &centroid_course_hz(output, sample_rate_hz, fundamental_hz),
+        &centroid_course_hz(yardstick, sample_rate_hz, yardstick_hz),
+    );
+    (cents_error, distance, formant)
 }
 
 /// The four measures of `render` against `reference`, two renders of one pluck at the same
