@@ -177,15 +177,11 @@ fn pitch_extremes() {
 #[test]
 fn output_rates_from_22050_to_384000() {
     for rate in [22_050.0, 48_000.0, 96_000.0, 192_000.0, 384_000.0] {
-        let settings = VoiceSettings {
-            quality: Quality::Live,
-            ..VoiceSettings::default()
-        };
         // The cheapest and the most expensive tier bracket the others at every rate.
         for quality in [Quality::Live, Quality::Reference] {
             let settings = VoiceSettings {
                 quality,
-                ..settings
+                ..VoiceSettings::default()
             };
             let outcome = run(&settings, &Pluck::default(), rate);
             check(&format!("{rate} Hz at {}", quality.name()), &outcome, false);

@@ -36,6 +36,7 @@ use crate::bench::{percentile, BLOCK, SAMPLE_RATE};
 use clap::Parser;
 use javari_core::bowed::BowTier;
 use javari_core::denormals::FlushDenormals;
+use javari_core::engine::preset::QUALITY_NAMES;
 use javari_core::engine::render::DEFAULT_VOICE_COUNT;
 use javari_core::engine::{
     BowedStringKind, Engine, EngineEvent, EngineSettings, Instrument, TimedEvent,
@@ -73,7 +74,7 @@ pub struct SoakArgs {
 
 fn quality_name(text: &str) -> Result<Quality, String> {
     Quality::from_name(text.trim())
-        .ok_or_else(|| format!("`{text}` is not a tier: live, fine, studio or reference"))
+        .ok_or_else(|| format!("`{text}` is not a tier: {}", QUALITY_NAMES.join(", ")))
 }
 
 // ---------------------------------------------------------------------------------------------

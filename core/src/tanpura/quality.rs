@@ -13,9 +13,9 @@
 //!   at one pluck (`docs/performance.md`, stop 29).
 //! - The draft tier (live's scheme with the modes below 10 kHz and the thread's points every
 //!   millimetre) was withdrawn in stop 62: its bridge never fed the upper band, at any key
-//!   measured, so it played no jawari (`docs/modal-tanpura.md` §14), and the signature tests
-//!   that hold every other modal tier could not hold it. A preset or a saved plugin state that
-//!   names it plays live ([`Quality::withdrawn`]).
+//!   measured, so it played no jawari (`docs/modal-tanpura.md` §14), and the falling formant's
+//!   signature test, which holds every other tier, could not hold it. A preset or a saved plugin
+//!   state that names it plays live ([`Quality::withdrawn`]).
 //! - Fine runs the modal scheme on the reference's own grid (`docs/modal-tanpura.md` §10–11): every
 //!   mode of the seed's FD grid (N = 200, the 199 sampled sines with the frequencies and decays
 //!   of its trapezoidal rule at 4× the output rate), advanced exactly at the output rate, with the
