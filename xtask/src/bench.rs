@@ -357,10 +357,11 @@ fn errors_against(
 }
 
 /// The scenes whose output is one string, so that the ten partials near n·f₀ are that string's
-/// and their cents measure its tuning. In the drone and eight-voices mixes the strongest line near
-/// n·f₀ may be another string's partial (`docs/tiers-log.md`, stop 34: a drone row read 43.73 cents for an
-/// eighth partial taken at another string's line, its other nine within 7.4), so their cents
-/// column stays empty; every string's tuning against the reference is the playing-range grid's.
+/// and their cents measure its tuning. In the drone and eight-voices mixes the strongest line
+/// near n·f₀ may be another string's partial (`docs/tiers-log.md`, stop 34: a drone row read
+/// 43.73 cents for an eighth partial taken at another string's line, its other nine within
+/// 7.4), so their cents column stays empty; every string's tuning against the reference is the
+/// playing-range grid's.
 fn scene_measures_tuning(scene: &str) -> bool {
     matches!(scene, "one-string" | "bowed-note")
 }
