@@ -23,3 +23,4 @@ pub mod newton;
 pub mod simd;
 pub mod snapshot;
 pub mod snapshot_channel;
+pub mod step_timers;

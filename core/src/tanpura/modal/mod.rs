@@ -44,6 +44,7 @@ pub mod step;
 
 use crate::newton::{NewtonSettings, NewtonStats};
 use crate::simd::CacheAligned;
+use crate::step_timers::{self, StepPart};
 use crate::tanpura::excitation::{finger_height_m, Pluck};
 use crate::tanpura::geometry::grid_points;
 use crate::tanpura::geometry::{BridgeSettings, FingerSettings, ThreadSettings};
@@ -1060,6 +1061,7 @@ impl<T: Real> ModalString<T> {
         // Whole groups of four rows (the dots past the nodes are never read), so that every
         // row takes the four-row kernel: NODE_CAPACITY is a multiple of four.
         let rows = self.nodal.node_count().next_multiple_of(4);
+        let time = step_timers::start();
         LeadingDots {
             matrix: &self.node_shapes,
             stride: MODE_CAPACITY,
@@ -1067,6 +1069,7 @@ impl<T: Real> ModalString<T> {
             out: &mut self.nodal.node_free_steps_m[..rows],
         }
         .with_simd(simd);
+        step_timers::add(StepPart::NodeDots, time);
         let outcome = self.nodal.step(
             &self.config.newton,
             self.config.track_energy,
@@ -1081,7 +1084,9 @@ impl<T: Real> ModalString<T> {
         for (value, change) in self.node_forces.iter_mut().zip(changes) {
             *value = T::from_f64(*change);
         }
+        let time = step_timers::start();
         self.advance_and_finish(simd, true, outcome.force_change_n, outcome.penetration_m);
+        step_timers::add(StepPart::Advance, time);
     }
 
     /// Puts to sleep the far points that the string's vibration energy cannot carry into

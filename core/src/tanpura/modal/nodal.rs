@@ -54,6 +54,7 @@ use super::solve::{
     ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed, ldl_substitute_in_place,
 };
 use crate::newton::NewtonSettings;
+use crate::step_timers::{self, StepPart};
 use crate::tanpura::contact::HuntCrossley;
 use crate::tanpura::fd::barrier_grid::lagrange_stencil;
 use std::f64::consts::PI;
@@ -802,13 +803,16 @@ impl NodalContact {
     /// Newton's iteration on S from the iterate in `slot_steps`. Returns (updates, converged).
     #[inline(always)]
     fn newton(&mut self, settings: &NewtonSettings) -> (u32, bool) {
+        let mut time = step_timers::start();
         let (_, _, mut crossings) = self.evaluate();
+        time = step_timers::add(StepPart::Evaluate, time);
         let mut updates = 0;
         loop {
             if updates >= settings.max_iterations {
                 return (updates, false);
             }
             self.sum_stiffnesses();
+            step_timers::add(StepPart::Stiffnesses, time);
             #[cfg(test)]
             let size = if self.general_path_only {
                 usize::MAX
@@ -827,8 +831,10 @@ impl NodalContact {
                 _ => self.update_general(crossings, tolerance_m),
             };
             updates += 1;
+            time = step_timers::start();
             let (changed, left_linear);
             (changed, left_linear, crossings) = self.evaluate();
+            time = step_timers::add(StepPart::Evaluate, time);
             // A finish stands if every point that was in a linear case kept it: the crossing
             // points' law was solved whole, in whichever case each ends.
             if !(changed || crossings > 0)
@@ -1064,6 +1070,7 @@ impl NodalContact {
         crossings: usize,
         tolerance_m: f64,
     ) -> (f64, bool) {
+        let time = step_timers::start();
         let m = self.set_count;
         let mut matrix = [[0.0; N]; N];
         let mut delta = [0.0; N];
@@ -1096,8 +1103,11 @@ impl NodalContact {
             }
         }
         self.add_stiffnesses_fixed(&mut matrix);
+        let time = step_timers::add(StepPart::UpdateSetup, time);
         ldl_factor_fixed(&mut matrix);
+        let time = step_timers::add(StepPart::Factorise, time);
         ldl_substitute_fixed(&matrix, &mut delta);
+        let time = step_timers::add(StepPart::Substitute, time);
         let finished = crossings > 0
             && self.finish_step(
                 |x: &mut [f64; N]| ldl_substitute_fixed(&matrix, x),
@@ -1105,11 +1115,13 @@ impl NodalContact {
                 crossings,
                 tolerance_m,
             );
+        step_timers::add(StepPart::FinishCrossings, time);
         (self.apply_update(&delta[..m]), finished)
     }
 
     /// [`NodalContact::update_in_lanes`] on any number of nodes (stride m, lower triangle).
     fn update_general(&mut self, crossings: usize, tolerance_m: f64) -> (f64, bool) {
+        let time = step_timers::start();
         let m = self.set_count;
         for a in 0..m {
             let mut rhs = self.slot_forces[a];
@@ -1123,12 +1135,15 @@ impl NodalContact {
         let mut matrix = std::mem::take(&mut self.matrix);
         self.add_stiffnesses(|a, b, value| matrix[a * m + b] += value);
         self.matrix = matrix;
+        let time = step_timers::add(StepPart::UpdateSetup, time);
+        // The factorisation and the substitution in one.
         ldl_solve_in_place(
             &mut self.matrix[..m * m],
             m,
             &mut self.right_side[..m],
             &mut self.scratch[..m],
         );
+        let time = step_timers::add(StepPart::Factorise, time);
         let mut delta = [0.0; NODE_CAPACITY];
         delta[..m].copy_from_slice(&self.right_side[..m]);
         let finished = crossings > 0
@@ -1140,6 +1155,7 @@ impl NodalContact {
                 crossings,
                 tolerance_m,
             );
+        step_timers::add(StepPart::FinishCrossings, time);
         (self.apply_update(&delta[..m]), finished)
     }
 
@@ -1209,9 +1225,11 @@ impl NodalContact {
         let mut iterations = 0;
         let mut converged = true;
         loop {
+            let time = step_timers::start();
             if self.set_changed {
                 self.form_set();
             }
+            step_timers::add(StepPart::FormSet, time);
             let m = self.set_count;
             for slot in 0..m {
                 let node = self.set_nodes[slot];
@@ -1224,6 +1242,7 @@ impl NodalContact {
                 iterations += updates;
                 converged &= done;
             }
+            let time = step_timers::start();
             // Every node's step: S's from Newton, the others' from the forces on S.
             for node in 0..n {
                 let slot = self.node_slots[node];
@@ -1243,6 +1262,7 @@ impl NodalContact {
             // whether one then lies within the band.
             // Each lane's largest `a_i` among the untracked points (the tracked ones' offset is
             // −∞): one of them touches if it is positive, lies within the band if above −band.
+            let time = step_timers::add(StepPart::NodeSteps, time);
             let mut reach = [f64::NEG_INFINITY; LANES];
             for (group, band) in self.group_bands[..self.group_count].iter().enumerate() {
                 let start = group * LANES;
@@ -1267,6 +1287,7 @@ impl NodalContact {
                 }
                 self.next_gaps_m[start..start + LANES].copy_from_slice(&next);
             }
+            step_timers::add(StepPart::PointPass, time);
             let touches = reach.iter().any(|&r| r > 0.0);
             let near = reach.iter().any(|&r| r > -band_m);
             self.far_point_near = near;
@@ -1289,6 +1310,7 @@ impl NodalContact {
             }
             self.set_changed = true;
         }
+        let time = step_timers::start();
         // The outcome, the nodal loads and the initial guess of the next step.
         let mut damping_loss_j = 0.0;
         let mut penetration_m = 0.0f64;
@@ -1324,7 +1346,9 @@ impl NodalContact {
                 0.0
             };
         }
+        let time = step_timers::add(StepPart::Outcome, time);
         self.update_tracking(band_m, release_m);
+        step_timers::add(StepPart::Tracking, time);
         NodalOutcome {
             iterations,
             converged,
