@@ -1,9 +1,9 @@
 //! Where a modal step's time goes, part by part: time-stamp-counter totals for a profiling build.
 //!
 //! The fine tier's whole step is one function compiled for the vector unit (`modal/mod.rs`,
-//! `WholeStep`), so `perf` sees one symbol, and resolving its samples by `addr2line -i` puts about
-//! two fifths of them on inlined std helpers (integer methods, slice indexing, iterators) rather
-//! than on the step's own lines (`docs/performance.md`, stop 63). With the `step-timers` feature
+//! `WholeStep`), so `perf` sees one symbol, and about two fifths of its instructions carry the
+//! line of an inlined std helper (integer methods, slice indexing, iterators) rather than one of
+//! the step's own (cachegrind, `docs/performance.md`, stop 63). With the `step-timers` feature
 //! each part of the step reads the processor's time-stamp counter where it starts and ends and
 //! adds the difference to its total; `cargo run --release -p javari-core --features step-timers
 //! --example step_parts` prints the totals per step. Without the feature every function here is
