@@ -5,8 +5,73 @@
 //! branch on an enum. The kernels themselves live beside the physics they serve, as inherent
 //! methods of [`Kernels`]: the FD step's passes over the string in `tanpura/fd/kernels.rs`, the
 //! modal step's passes over the modes in `tanpura/modal/lanes.rs`.
+//!
+//! **Capping the unit.** The environment variable `JAVARI_VECTOR_UNIT` (`avx512`, `avx2` or
+//! `scalar`) caps the unit at that level, never above what the machine has: so that one build
+//! can be timed on each unit of one machine (`docs/performance.md`, stop 65: AVX-512 against
+//! AVX2 on a Zen 4, whose 512-bit operations are two 256-bit halves), and so that a user whose
+//! machine slows down on the wider unit can choose the narrower one. It is read once per
+//! process, at the first detection (the constructors, never the audio thread's steps); an
+//! unknown value leaves the unit uncapped.
 
 use pulp::Arch;
+use std::sync::OnceLock;
+
+/// The environment variable that caps the vector unit.
+pub const VECTOR_UNIT_VARIABLE: &str = "JAVARI_VECTOR_UNIT";
+
+/// The most a cap lets the detection choose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Level {
+    Scalar,
+    Avx2,
+    Avx512,
+}
+
+/// The level named by `JAVARI_VECTOR_UNIT`'s value, if it names one.
+fn level_named(value: &str) -> Option<Level> {
+    match value.trim().to_ascii_lowercase().as_str() {
+        "avx512" | "avx-512" => Some(Level::Avx512),
+        "avx2" => Some(Level::Avx2),
+        "scalar" => Some(Level::Scalar),
+        _ => None,
+    }
+}
+
+/// The widest unit of this CPU no wider than `cap`.
+fn arch_at_most(cap: Level) -> Arch {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if cap >= Level::Avx512 {
+            if let Some(simd) = pulp::x86::V4::try_new() {
+                return Arch::V4(simd);
+            }
+        }
+        if cap >= Level::Avx2 {
+            if let Some(simd) = pulp::x86::V3::try_new() {
+                return Arch::V3(simd);
+            }
+        }
+        Arch::Scalar
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = cap;
+        Arch::new()
+    }
+}
+
+/// The unit every kernel runs on: detected once, under the environment's cap.
+pub fn vector_unit() -> Arch {
+    static UNIT: OnceLock<Arch> = OnceLock::new();
+    *UNIT.get_or_init(|| {
+        let cap = std::env::var(VECTOR_UNIT_VARIABLE)
+            .ok()
+            .and_then(|value| level_named(&value))
+            .unwrap_or(Level::Avx512);
+        arch_at_most(cap)
+    })
+}
 
 /// The detected vector unit; the kernels are its methods.
 #[derive(Debug, Clone, Copy)]
@@ -21,9 +86,11 @@ impl Default for Kernels {
 }
 
 impl Kernels {
-    /// The widest vector unit of this CPU.
+    /// The widest vector unit of this CPU (under `JAVARI_VECTOR_UNIT`'s cap, if set).
     pub fn detect() -> Self {
-        Self { arch: Arch::new() }
+        Self {
+            arch: vector_unit(),
+        }
     }
 
     /// The vector unit in use, for reports ("AVX-512", "AVX2+FMA" or "scalar").
@@ -111,6 +178,26 @@ impl<T: Copy + std::fmt::Debug> std::fmt::Debug for CacheAligned<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_cap_names_a_level_and_never_widens_the_unit() {
+        assert_eq!(level_named("avx512"), Some(Level::Avx512));
+        assert_eq!(level_named(" AVX2 "), Some(Level::Avx2));
+        assert_eq!(level_named("scalar"), Some(Level::Scalar));
+        assert_eq!(level_named("sse9"), None);
+        let widest = Kernels {
+            arch: arch_at_most(Level::Avx512),
+        };
+        assert_eq!(widest.name(), Kernels { arch: Arch::new() }.name());
+        let scalar = Kernels {
+            arch: arch_at_most(Level::Scalar),
+        };
+        assert_eq!(scalar.name(), "scalar");
+        let avx2 = Kernels {
+            arch: arch_at_most(Level::Avx2),
+        };
+        assert_ne!(avx2.name(), "AVX-512");
+    }
 
     #[test]
     fn cache_aligned_arrays_start_on_a_cache_line_and_clone_their_contents() {

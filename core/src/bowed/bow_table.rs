@@ -123,7 +123,8 @@ pub struct BowTableString {
     bow_position: f64,
     slope: f64,
     run_scratch: RunScratch,
-    /// The vector unit the block path is compiled for, detected once ([`RenderOnUnit`]).
+    /// The vector unit the block path is compiled for, detected once under
+    /// `JAVARI_VECTOR_UNIT`'s cap ([`crate::simd::vector_unit`], [`RenderOnUnit`]).
     arch: pulp::Arch,
 }
 
@@ -157,7 +158,7 @@ impl BowTableString {
             bow_position: 0.1,
             slope: bow_table_slope(0.0),
             run_scratch: RunScratch::default(),
-            arch: pulp::Arch::new(),
+            arch: crate::simd::vector_unit(),
         };
         voice.update_delays();
         voice
