@@ -14,8 +14,9 @@
 //! five minutes on two cores); `-- --grid-modes` the same with every mode of the reference's FD
 //! grid instead of the continuous string's (§10); `-- --grid-spacings` the grid modes with the
 //! contact condensed on the nodes (§11) and contact points from the reference's spacing to the
-//! tier's; `-- --bands KEY VELOCITY POSITION_M` which 1/6-octave bands part the fine tier, the
-//! studio tier, the reference and the refined string at one pluck; `-- --fine-rates` the fine
+//! tier's; `-- --bands KEY VELOCITY POSITION_M [--as-played]` which 1/6-octave bands part the
+//! fine tier, the studio tier, the reference and the refined string at one pluck (with
+//! `--as-played`, the tiers calibrated as the bench's grid calibrates them); `-- --fine-rates` the fine
 //! tier's string at the output rate and at twice it over the whole grid against the reference
 //! (tuned by linearisation; no refined renders). `cargo xtask bench` measures
 //! the same without the residual modes, and caches the refined renders.
@@ -30,7 +31,9 @@
 use javari_core::analysis::listening::{
     band_edges_hz, band_levels_db, compare, counted_band_differences_db, ListeningDifference,
 };
-use javari_core::analysis::playing_range::{full_grid, GridPoint, CREST_KEYS};
+use javari_core::analysis::playing_range::{
+    calibrate, full_grid, render_as_played, GridPoint, CREST_KEYS, NOTE_SECONDS,
+};
 use javari_core::analysis::refined::{
     grid_pluck, grid_render_linearised, grid_render_refined, modal_variant_pluck,
     reference_pluck_on_grid, refined_reference_pluck, yardstick_grid, ModalVariant,
@@ -517,35 +520,49 @@ fn live_variants(args: &[String]) {
     }
 }
 
-/// Per band of [`band_edges_hz`]: the RMS over the frames of `render`'s level less
+/// Per band of [`band_edges_hz`]: the RMS and the mean over the frames of `render`'s level less
 /// `reference`'s, counted as the band-level measure counts it
 /// ([`counted_band_differences_db`]), and in how many frames the band counted.
-fn band_differences(render: &[f64], reference: &[f64]) -> Vec<(f64, usize)> {
+fn band_differences(render: &[f64], reference: &[f64]) -> Vec<(f64, f64, usize)> {
     let (mine, theirs) = (
         band_levels_db(render, SAMPLE_RATE_HZ),
         band_levels_db(reference, SAMPLE_RATE_HZ),
     );
     let bands = theirs.first().map_or(0, Vec::len);
-    let mut sums = vec![(0.0, 0usize); bands];
+    let mut sums = vec![(0.0, 0.0, 0usize); bands];
     for (frame, reference_frame) in mine.iter().zip(&theirs) {
         for (band, difference) in counted_band_differences_db(frame, reference_frame) {
             sums[band].0 += difference.powi(2);
-            sums[band].1 += 1;
+            sums[band].1 += difference;
+            sums[band].2 += 1;
         }
     }
     sums.into_iter()
-        .map(|(sum, count)| ((sum / count.max(1) as f64).sqrt(), count))
+        .map(|(squares, sum, count)| {
+            let frames = count.max(1) as f64;
+            ((squares / frames).sqrt(), sum / frames, count)
+        })
         .collect()
 }
 
-/// `--bands KEY VELOCITY POSITION_M`: one pluck of the grid on the reference, the fine and the
-/// studio tier and the refined string, all tuned by linearisation: each pair's band-level
-/// distance (the bench's measure), then band by band the reference's mean level and each
-/// difference's RMS over the frames (see [`band_differences`]): which bands part the tiers, and
-/// whether the reference is nearer the refined string there than the fine tier is.
+/// `--bands KEY VELOCITY POSITION_M [--as-played]`: one pluck of the grid on the reference, the
+/// fine and the studio tier and the refined string, all tuned by linearisation (with
+/// `--as-played` the three tiers calibrated as played, as the bench's grid renders them; the
+/// refined string stays linearised): each pair's band-level distance (the bench's measure), then
+/// band by band the reference's mean level, each difference's RMS over the frames and the fine
+/// tier's mean difference (see [`band_differences`]): which bands part the tiers, which way,
+/// and whether the reference is nearer the refined string there than the fine tier is.
 fn bands(args: &[String]) {
     let (_, point) = pluck_after(args, "--bands");
-    let render = |quality| grid_render_linearised(quality, &point, SAMPLE_RATE_HZ, 0);
+    let as_played = args.iter().any(|arg| arg == "--as-played");
+    let render = |quality| {
+        if as_played {
+            let calibration = calibrate(quality, point.key, point.pluck_position_m, SAMPLE_RATE_HZ);
+            render_as_played(quality, &point, NOTE_SECONDS, SAMPLE_RATE_HZ, &calibration)
+        } else {
+            grid_render_linearised(quality, &point, SAMPLE_RATE_HZ, 0)
+        }
+    };
     let (reference, fine, studio) = (
         render(Quality::Reference),
         render(Quality::Fine),
@@ -554,10 +571,12 @@ fn bands(args: &[String]) {
     let refined = grid_render_refined(&point, SAMPLE_RATE_HZ);
     let nominal = point.nominal_hz();
     let distance = |a: &[f64], b: &[f64]| compare(a, b, SAMPLE_RATE_HZ, nominal).band_level_db;
-    println!(
-        "{}, tuned by linearisation: band-level distances (dB RMS)",
-        point.label()
-    );
+    let tuning = if as_played {
+        "the tiers tuned as played, the refined string by linearisation"
+    } else {
+        "tuned by linearisation"
+    };
+    println!("{}, {tuning}: band-level distances (dB RMS)", point.label());
     for (label, render, against) in [
         ("fine against the reference", &fine, &reference),
         ("studio against the reference", &studio, &reference),
@@ -574,18 +593,19 @@ fn bands(args: &[String]) {
         band_differences(&reference, &refined),
         band_differences(&fine, &refined),
     ];
-    println!("band centre Hz, reference mean dB, frames counted; RMS dB: fine−ref, studio−ref, ref−refined, fine−refined");
+    println!("band centre Hz, reference mean dB, frames counted; RMS dB: fine−ref, studio−ref, ref−refined, fine−refined; mean dB: fine−ref");
     for (band, edges) in band_edges_hz(SAMPLE_RATE_HZ).windows(2).enumerate() {
         let mean = levels.iter().map(|frame| frame[band]).sum::<f64>() / levels.len().max(1) as f64;
         println!(
-            "{:8.0} {:7.1} {:3} {:6.2} {:6.2} {:6.2} {:6.2}",
+            "{:8.0} {:7.1} {:3} {:6.2} {:6.2} {:6.2} {:6.2} {:+6.2}",
             (edges[0] * edges[1]).sqrt(),
             mean,
-            pairs[0][band].1,
+            pairs[0][band].2,
             pairs[0][band].0,
             pairs[1][band].0,
             pairs[2][band].0,
-            pairs[3][band].0
+            pairs[3][band].0,
+            pairs[0][band].1
         );
     }
 }
