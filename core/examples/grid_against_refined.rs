@@ -16,10 +16,10 @@
 //! contact condensed on the nodes (§11) and contact points from the reference's spacing to the
 //! tier's; `-- --bands KEY VELOCITY POSITION_M [--as-played]` which 1/6-octave bands part the
 //! fine tier, the studio tier, the reference and the refined string at one pluck (with
-//! `--as-played`, the tiers calibrated as the bench's grid calibrates them); `-- --fine-rates` the fine
-//! tier's string at the output rate and at twice it over the whole grid against the reference
-//! (tuned by linearisation; no refined renders). `cargo xtask bench` measures
-//! the same without the residual modes, and caches the refined renders.
+//! `--as-played`, the tiers calibrated as the bench's grid calibrates them); `-- --fine-rates`
+//! the fine tier's string at the output rate and at twice it over the whole grid against the
+//! reference (tuned by linearisation; no refined renders). `cargo xtask bench` measures the same
+//! without the residual modes, and caches the refined renders.
 //!
 //! Each pluck is the grid's (`refined::grid_pluck`), rendered by a fresh voice of each tier, every
 //! tier tuned by linearising about its own rest state (no calibration as played), so that the
