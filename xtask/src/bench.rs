@@ -23,7 +23,7 @@
 use crate::args::number_in;
 use crate::calibration_cache::CalibrationCache;
 use crate::playing_range::{self, TierOverGrid};
-use crate::render::render_on;
+use crate::render::{render_on, RENDER_BLOCK};
 use clap::Parser;
 use javari_core::analysis::listening::one_string_errors;
 use javari_core::analysis::refined::{refined_reference_pluck, RefinedRender};
@@ -1162,8 +1162,8 @@ pub fn to_markdown(machine: &str, runs: u32, results: &[BenchResult]) -> String 
     text
 }
 
-/// `cargo xtask render` with no arguments (the demo scene, the reference tier, 512-sample
-/// blocks), timed on `threads` threads: its first render, which measures every string's
+/// `cargo xtask render` with no arguments (the demo scene, the reference tier, its default
+/// blocks of [`RENDER_BLOCK`] samples), timed on `threads` threads: its first render, which measures every string's
 /// calibration alongside the render, and the same render with the calibrations read back.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DemoRender {
@@ -1195,7 +1195,10 @@ fn run_demo_render() -> Option<DemoRender> {
     let threads = std::thread::available_parallelism().map_or(1, usize::from);
     let settings = EngineSettings::default();
     let score = Score::demo();
-    let options = RenderOptions::default();
+    let options = RenderOptions {
+        block_size: RENDER_BLOCK,
+        ..RenderOptions::default()
+    };
     let directory = match tempfile::tempdir() {
         Ok(directory) => directory,
         Err(error) => {

@@ -40,7 +40,7 @@ use javari_core::engine::render::{
 };
 use javari_core::engine::wav::read_wav;
 use javari_core::engine::{EngineSettings, Instrument, VoiceRunner, VoiceTask};
-use javari_core::tanpura::as_played::Calibration;
+use javari_core::tanpura::as_played::{with_plucks_at_once, Calibration};
 use javari_core::tanpura::quality::Quality;
 use rayon::prelude::*;
 use std::io::{BufWriter, IsTerminal};
@@ -64,8 +64,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "HZ", default_value_t = 44_100.0,
           value_parser = number_in(8_000.0, 192_000.0))]
     sample_rate: f64,
-    /// Samples per process call, as a host's buffer size (1 to 65536).
-    #[arg(long, value_name = "N", default_value_t = 512, value_parser = number_in(1usize, 65_536))]
+    /// Samples per process call, as a host's buffer size (1 to 65536). The output is the same
+    /// for any; long blocks let each voice run as one long task a segment on the threads
+    /// (`docs/performance.md`, stop 68).
+    #[arg(long, value_name = "N", default_value_t = RENDER_BLOCK, value_parser = number_in(1usize, 65_536))]
     block_size: usize,
     /// Quality tier; `preset` keeps the preset's own (reference without a preset).
     #[arg(long, value_name = "TIER", default_value = "preset",
@@ -107,6 +109,12 @@ pub struct RenderArgs {
     #[arg(long)]
     no_calibration_cache: bool,
 }
+
+/// The render's default block: offline, a segment's voices run as one task each through the
+/// control ticks that change nothing (`Engine::process_with`), up to the block's end, so a long
+/// block lets the threads share the voices of a segment evenly (the demo with its calibrations
+/// read back, on two cores: 7.4–7.6 s at 512 samples, 6.4–6.6 s at 32768; stop 68).
+pub(crate) const RENDER_BLOCK: usize = 32_768;
 
 /// Largest WAV data chunk: its length field has 32 bits.
 const WAV_MAX_DATA_BYTES: u64 = u32::MAX as u64 - 44;
@@ -594,7 +602,7 @@ pub(crate) struct Tuned {
 /// `jobs`.
 ///
 /// Each string's calibration is read from `cache` when an earlier run kept it, else measured and
-/// kept, and handed to the engine just before the block that first plucks the string
+/// kept, and handed to the engine just before the sample that first plucks the string
 /// ([`render_blocks_scheduled`], [`calibration_need_samples`]), whatever `jobs` is. With one job
 /// it is measured there. With `jobs` > 1 the pool has `jobs` threads for the calibrations and the
 /// voices and one more, which drives the render: it hands out each segment's voices and takes
@@ -620,7 +628,10 @@ pub(crate) fn render_on(
     let needed_at = calibration_need_samples(settings, score, options.sample_rate_hz, &requests);
     let measure = |index: usize| {
         let started = Instant::now();
-        let (calibration, source) = calibration(cache, &requests[index], options.sample_rate_hz);
+        // A check's plucks render on `jobs` threads at most (one thread with one job).
+        let (calibration, source) = with_plucks_at_once(jobs, || {
+            calibration(cache, &requests[index], options.sample_rate_hz)
+        });
         Tuned {
             calibration,
             source,

@@ -498,7 +498,20 @@ const VOICE_RUN: usize = 64;
 
 /// Runs `slot`'s voice for `length` samples, handing each scaled sample to `emit(index, value)`,
 /// and updates the slot's level. A voice that blows up is silenced and emits nothing more.
-fn run_slot(slot: &mut Slot, release: f32, length: usize, mut emit: impl FnMut(usize, f32)) {
+///
+/// `first_tick` is the index of the first control tick inside the run (the ticks follow every
+/// [`CONTROL_INTERVAL`] samples; one at or beyond `length` is none). A segment of the audio
+/// thread ends at its next tick, so it has none inside; an offline segment runs through the
+/// ticks that change nothing (`Engine::control_ticks_are_idle`), and at each of them the voice
+/// is looked at as a segment starting there would look at it: asleep, it stops and its level
+/// is 0. So the samples and the level do not depend on where the segments end.
+fn run_slot(
+    slot: &mut Slot,
+    release: f32,
+    length: usize,
+    first_tick: usize,
+    mut emit: impl FnMut(usize, f32),
+) {
     if !slot.voice.is_active() {
         slot.level = 0.0;
         return;
@@ -509,8 +522,16 @@ fn run_slot(slot: &mut Slot, release: f32, length: usize, mut emit: impl FnMut(u
     // `next_sample`, with one dispatch to the vector unit per run for a modal string).
     let mut run = [0.0f32; VOICE_RUN];
     let mut start = 0;
+    let mut next_tick = first_tick.max(1);
     'samples: while start < length {
-        let count = (length - start).min(VOICE_RUN);
+        if start == next_tick {
+            next_tick = next_tick.saturating_add(CONTROL_INTERVAL as usize);
+            if !slot.voice.is_active() {
+                level = 0.0;
+                break;
+            }
+        }
+        let count = (length - start).min(VOICE_RUN).min(next_tick - start);
         slot.voice.process(&mut run[..count]);
         for (index, &sample) in (start..).zip(&run[..count]) {
             let value = slot.delay.process(sample * scale);
@@ -534,6 +555,8 @@ fn run_slot(slot: &mut Slot, release: f32, length: usize, mut emit: impl FnMut(u
 pub struct VoiceTask<'a> {
     slot: &'a mut Slot,
     release: f32,
+    /// The first control tick inside the segment ([`run_slot`]).
+    first_tick: usize,
     samples: &'a mut [f32],
     /// Samples produced: all of them, or fewer when the voice blew up and was silenced.
     written: usize,
@@ -544,10 +567,16 @@ impl VoiceTask<'_> {
     pub fn run(&mut self) {
         let samples = &mut *self.samples;
         let mut written = 0;
-        run_slot(self.slot, self.release, samples.len(), |index, value| {
-            samples[index] = value;
-            written = index + 1;
-        });
+        run_slot(
+            self.slot,
+            self.release,
+            samples.len(),
+            self.first_tick,
+            |index, value| {
+                samples[index] = value;
+                written = index + 1;
+            },
+        );
         self.written = written;
     }
 }
@@ -1086,7 +1115,15 @@ impl Engine {
             if let Some(timed) = events.get(next_event) {
                 end = end.min(timed.offset.min(length - 1));
             }
-            end = end.min(position + (self.next_control_tick - self.clock) as usize);
+            // Ticks until the next tick, at or after the clock (the tick of this sample has run).
+            let first_tick = (self.next_control_tick - self.clock) as usize;
+            // Offline (a runner), a segment runs through the control ticks that would change
+            // nothing, so that a segment hands its voices out once, not every
+            // [`CONTROL_INTERVAL`] samples; the ticks inside it are then skipped, on their grid.
+            let through_ticks = runner.is_some() && self.control_ticks_are_idle();
+            if !through_ticks {
+                end = end.min(position + first_tick);
+            }
             if let Some(pluck_sample) = self
                 .drone
                 .next_pluck_sample(&self.target.drone, self.sample_rate_hz)
@@ -1096,17 +1133,26 @@ impl Engine {
             }
             let end = end.max(position + 1);
             let side_segment = side.as_deref_mut().map(|side| &mut side[position..end]);
-            self.render_segment(&mut output[position..end], side_segment, runner);
+            self.render_segment(&mut output[position..end], side_segment, runner, first_tick);
             self.clock += (end - position) as u64;
             position = end;
+            if self.next_control_tick < self.clock {
+                // The idle ticks the segment ran through: the next is the first at or after the
+                // clock, on the same grid.
+                let skipped = (self.clock - self.next_control_tick).div_ceil(CONTROL_INTERVAL);
+                self.next_control_tick += skipped * CONTROL_INTERVAL;
+            }
         }
     }
 
+    /// Renders one segment: `first_tick` is the index of its first control tick inside it, if
+    /// any (beyond its end on the audio thread; [`run_slot`]).
     fn render_segment(
         &mut self,
         output: &mut [f32],
         mut side: Option<&mut [f32]>,
         runner: Option<VoiceRunner<'_>>,
+        first_tick: usize,
     ) {
         let width = self.target.stereo_width as f32;
         if self.target.instrument == Instrument::Bowed {
@@ -1133,14 +1179,16 @@ impl Engine {
                     match side.as_deref_mut() {
                         Some(side) => {
                             let weight = slot.pan * width;
-                            run_slot(slot, release, output.len(), |index, value| {
+                            run_slot(slot, release, output.len(), first_tick, |index, value| {
                                 output[index] += value;
                                 side[index] += weight * value;
                             });
                         }
-                        None => run_slot(slot, release, output.len(), |index, value| {
-                            output[index] += value
-                        }),
+                        None => {
+                            run_slot(slot, release, output.len(), first_tick, |index, value| {
+                                output[index] += value
+                            })
+                        }
                     }
                 }
             }
@@ -1162,6 +1210,7 @@ impl Engine {
                         Some(VoiceTask {
                             slot,
                             release,
+                            first_tick,
                             samples,
                             written: 0,
                         })
@@ -1214,6 +1263,36 @@ impl Engine {
 
     /// `read` of each smoothed control, in the order [`Engine::voice_with_controls`] takes
     /// them: the bridge's stiffness (logarithmic), the thread's position, γ, η, the pickup mix.
+    /// True when every control tick until the next event or drone pluck would change nothing
+    /// ([`Engine::control_tick`]): the smoothed controls settled at the settings the strings
+    /// were last given, no retune pending, and each drone string's level at its setting's. Such
+    /// a tick leaves the next one idle too, so a segment may run through all of them.
+    fn control_ticks_are_idle(&self) -> bool {
+        let ramps = [
+            &self.bridge_stiffness_log,
+            &self.thread_position,
+            &self.gamma,
+            &self.eta,
+            &self.pickup_weight,
+        ];
+        if self.retune_pending || ramps.iter().any(|ramp| ramp.is_ramping()) {
+            return false;
+        }
+        // In the order of [`Engine::smoothed_controls`].
+        let mut settings = self.voice_with_controls(ramps.map(Ramp::value));
+        settings.fundamental_hz = self.current_voice.fundamental_hz;
+        // A drone string's level changes with its setting, which also sets a retune pending
+        // (`Engine::set_settings`); looked at here all the same, so that the ticks' effect is
+        // checked where it is made.
+        settings == self.current_voice
+            && self.slots.iter().all(|slot| match slot.key {
+                Some(StringKey::Drone(index)) => {
+                    slot.level_factor == slot.pitch_level * self.drone_levels[index]
+                }
+                _ => true,
+            })
+    }
+
     fn smoothed_controls(&mut self, mut read: impl FnMut(&mut Ramp) -> f64) -> [f64; 5] {
         [
             read(&mut self.bridge_stiffness_log),

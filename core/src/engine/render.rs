@@ -258,8 +258,8 @@ pub fn render_blocks_calibrated<E>(
     )
 }
 
-/// [`render_blocks_calibrated`] with calibration `i` taken from `calibration(i)` just before the
-/// block that holds sample `needed_at[i]` ([`calibration_need_samples`]), in the order of those
+/// [`render_blocks_calibrated`] with calibration `i` taken from `calibration(i)` just before
+/// sample `needed_at[i]` ([`calibration_need_samples`]; a block is cut there), in the order of those
 /// samples (ties by index), so that a renderer can measure the strings a score plucks later
 /// while it renders the first. `calibration` may wait for its calibration to be measured; it is
 /// called once for each index, and not at all for one needed after the render's end. The
@@ -305,6 +305,15 @@ pub fn render_blocks_scheduled<E>(
                 break;
             }
             engine_events += usize::from(!is_tempo);
+        }
+        // And at the first pluck of a string whose calibration is still to come, so that it is
+        // taken just before that pluck whatever the block size.
+        let later = schedule[next_calibration..]
+            .iter()
+            .map(|&index| needed_at[index])
+            .find(|&needed| needed > start);
+        if let Some(needed) = later.filter(|&needed| needed < end) {
+            end = needed;
         }
         while let Some(&index) = schedule.get(next_calibration) {
             if needed_at[index] >= end {
@@ -484,6 +493,51 @@ mod tests {
     /// Each string of the demo is needed from its first note-on (the arpeggio's E3 and G3 only
     /// from 10.25 and 10.5 s, so a renderer measures them while it renders the drone), and every
     /// string of a drone on a fixed Sa from the start.
+    /// A calibration is taken when the render has reached its string's first pluck, not at the
+    /// start of a long block that holds it: a block is cut there (so that a renderer measuring
+    /// later strings alongside has until the pluck itself).
+    #[test]
+    fn a_calibration_is_taken_at_its_strings_first_pluck_whatever_the_block() {
+        let mut settings = EngineSettings::default();
+        settings.voice.quality = crate::tanpura::quality::Quality::Live;
+        let mut score = Score::default();
+        for (index, note) in [43u8, 48, 52].into_iter().enumerate() {
+            score.note(0.013 * index as f64, 0.01, note, 0.9);
+        }
+        let options = RenderOptions {
+            tail_s: 0.01,
+            block_size: 4096,
+            ..RenderOptions::default()
+        };
+        let requests = calibration_requests(&settings, &score);
+        let needed_at = calibration_need_samples(&settings, &score, 44_100.0, &requests);
+        assert_eq!(needed_at, [0, 573, 1147]);
+        let rendered = std::cell::Cell::new(0);
+        let taken_at = std::cell::RefCell::new(Vec::new());
+        let result: Result<(), ()> = render_blocks_scheduled(
+            &settings,
+            &needed_at,
+            &mut |index| {
+                taken_at.borrow_mut().push(rendered.get());
+                Calibration {
+                    request: requests[index],
+                    sample_rate_hz: 44_100.0,
+                    offset_cents: 0.0,
+                    thread_offset_m: 0.0,
+                }
+            },
+            &score,
+            &options,
+            None,
+            &mut |block| {
+                rendered.set(rendered.get() + block.len());
+                Ok(())
+            },
+        );
+        result.unwrap();
+        assert_eq!(taken_at.into_inner(), needed_at);
+    }
+
     #[test]
     fn a_string_is_needed_from_the_first_note_on_that_plucks_it() {
         let settings = EngineSettings::default();

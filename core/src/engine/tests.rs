@@ -1043,3 +1043,147 @@ fn a_glides_last_retune_of_a_ringing_string_takes_the_plans_tension() {
     assert!(unplanned_tunings >= 4, "{unplanned_tunings}");
     assert_eq!(planned_tunings + 4, unplanned_tunings);
 }
+
+/// A scripted performance rendered block by block ([`scripted_performance`]).
+struct Performance {
+    /// Both stereo channels and, after every block, each voice's level and whether it is active.
+    bits: Vec<u32>,
+    /// Voices that fell asleep in a block without an event.
+    fell_asleep: usize,
+    /// Voices playing drone strings at the end.
+    drone_voices: usize,
+}
+
+/// A performance rendered in `block_size` blocks, the voices run by `runner` (`None`: one after
+/// another, as on the audio thread). On the live tier with γ at its largest, so that soft notes
+/// fall asleep within about half a second: soft and firm notes, a glide of the bridge and the
+/// thread (whose ticks retune the ringing strings), the thread taken off (no ramp, the same
+/// retunes), a quiet stretch in which strings fall asleep, the drone turned on at a fast tempo, and a drone string's level changed. A change of
+/// settings lands at the first block that starts at or after its sample.
+fn scripted_performance(block_size: usize, runner: Option<VoiceRunner<'_>>) -> Performance {
+    const SAMPLES: usize = 70_000;
+    let mut settings = EngineSettings::default();
+    settings.voice.quality = Quality::Live;
+    settings.voice.gamma_per_s = 20.0;
+    settings.drone.enabled = false;
+    let mut engine = Engine::new(&settings, RATE, 4);
+    let notes = [
+        (0usize, 48u8, 0.05f32),
+        (101, 55, 0.05),
+        (333, 60, 1.0),
+        (30_017, 52, 0.3),
+    ];
+    let mut glide = settings;
+    glide.voice.thread_position_m += 0.5e-3;
+    glide.voice.bridge_stiffness_n_m2 *= 3.0;
+    // A setting without a ramp: its ticks retune the ringing strings all the same.
+    let mut unthreaded = glide;
+    unthreaded.voice.thread_enabled = false;
+    let mut drone = unthreaded;
+    drone.drone.enabled = true;
+    drone.drone.sa_note = Some(50);
+    drone.drone.free_tempo_bpm = 240.0;
+    let mut quieter = drone;
+    quieter.drone.strings[1].level_db -= 6.0;
+    let changes = [
+        (8_000usize, glide),
+        (36_000, unthreaded),
+        (40_000, drone),
+        (55_000, quieter),
+    ];
+    let mut next_change = 0;
+    let (mut left, mut right) = (vec![0.0f32; block_size], vec![0.0f32; block_size]);
+    let mut performance = Performance {
+        bits: Vec::new(),
+        fell_asleep: 0,
+        drone_voices: 0,
+    };
+    let mut start = 0;
+    while start < SAMPLES {
+        let length = block_size.min(SAMPLES - start);
+        while let Some((_, changed)) = changes.get(next_change).filter(|(at, _)| *at <= start) {
+            engine.set_settings(changed);
+            next_change += 1;
+        }
+        let events: Vec<TimedEvent> = notes
+            .iter()
+            .filter(|(at, _, _)| (start..start + length).contains(at))
+            .map(|&(at, note, velocity)| TimedEvent {
+                offset: at - start,
+                event: EngineEvent::NoteOn { note, velocity },
+            })
+            .collect();
+        let active_before: Vec<bool> = engine.slots.iter().map(|s| s.voice.is_active()).collect();
+        let (left, right) = (&mut left[..length], &mut right[..length]);
+        match runner {
+            None => engine.process_stereo(&events, left, right),
+            Some(runner) => engine.process_stereo_with(&events, left, right, runner),
+        }
+        let bits = &mut performance.bits;
+        bits.extend(left.iter().chain(&*right).map(|x| x.to_bits()));
+        for (slot, &was_active) in engine.slots.iter().zip(&active_before) {
+            bits.push(slot.level.to_bits());
+            bits.push(u32::from(slot.voice.is_active()));
+            let quiet_block = events.is_empty() && !engine.target.drone.enabled;
+            performance.fell_asleep +=
+                usize::from(quiet_block && was_active && !slot.voice.is_active());
+        }
+        start += length;
+    }
+    performance.drone_voices = engine
+        .slots
+        .iter()
+        .filter(|slot| matches!(slot.key, Some(StringKey::Drone(_))))
+        .count();
+    performance
+}
+
+/// Offline, a segment runs through the control ticks that change nothing, and the samples, the
+/// levels and the voices' activity stay those of the audio thread's segments, which end at every
+/// tick, to the bit: through notes, a glide, a change without a ramp, strings falling asleep
+/// between two ticks, drone
+/// plucks and a drone level change, at any block size and whatever order the voices run in.
+#[test]
+fn offline_segments_through_idle_ticks_render_the_audio_threads_bits() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let segments = AtomicUsize::new(0);
+    let in_order = |tasks: &mut [VoiceTask<'_>]| {
+        segments.fetch_add(1, Ordering::Relaxed);
+        tasks.iter_mut().for_each(VoiceTask::run);
+    };
+    let reversed = |tasks: &mut [VoiceTask<'_>]| tasks.iter_mut().rev().for_each(VoiceTask::run);
+    let ticks = 70_000 / CONTROL_INTERVAL as usize;
+    for block_size in [64, 333, 512, 4096] {
+        let audio_thread = scripted_performance(block_size, None);
+        assert!(
+            audio_thread.fell_asleep >= 2,
+            "{}",
+            audio_thread.fell_asleep
+        );
+        assert!(
+            audio_thread.drone_voices >= 2,
+            "{}",
+            audio_thread.drone_voices
+        );
+        assert!(audio_thread.bits.iter().any(|&x| f32::from_bits(x) != 0.0));
+        segments.store(0, Ordering::Relaxed);
+        let offline = scripted_performance(block_size, Some(&in_order));
+        assert!(
+            audio_thread.bits == offline.bits,
+            "block size {block_size}: the bits differ"
+        );
+        let counted = segments.load(Ordering::Relaxed);
+        if block_size >= 512 {
+            // The quiet stretches run a block at a time.
+            assert!(
+                counted < ticks / 2,
+                "block size {block_size}: {counted} segments"
+            );
+        }
+        let offline = scripted_performance(block_size, Some(&reversed));
+        assert!(
+            audio_thread.bits == offline.bits,
+            "block size {block_size}: the order matters"
+        );
+    }
+}

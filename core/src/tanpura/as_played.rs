@@ -78,6 +78,8 @@
 //! The result is a plain number of cents and a thread move per string, which the engine adds to
 //! the string's target and thread position ([`AsPlayedTuning`]).
 
+use std::cell::Cell;
+
 use super::excitation::Pluck;
 use super::quality::Quality;
 use super::voice::{TanpuraVoice, VoiceSettings};
@@ -322,15 +324,72 @@ fn check<const N: usize>(
         cents: [0.0; N],
         brightness_db: 0.0,
     };
-    for (index, &velocity) in velocities.iter().enumerate() {
-        let signal = render_pluck(voice, target, pluck, velocity, sample_rate_hz);
-        let pitch = sustained_pitch_hz(&signal, sample_rate_hz, nominal);
+    // The plucks are independent (each retunes the string and starts it from rest): in groups
+    // of [`with_plucks_at_once`]'s number, all but the last of a group render on copies of the
+    // voice on threads of their own and the last on `voice`, which it leaves as one pluck after
+    // another would. Each render is that of the voice as the check found it, to the bit
+    // (`a_check_renders_its_plucks_as_one_after_another`). On threads of their own, not a
+    // pool's: a thread of the renderer's pool waiting in a join could otherwise take a pluck
+    // and hold the render back for a whole pluck.
+    let at_once = PLUCKS_AT_ONCE.with(Cell::get).clamp(1, N);
+    let mut signals: Vec<Vec<f64>> = Vec::with_capacity(N);
+    for group in velocities.chunks(at_once) {
+        let (&last, others) = group.split_last().expect("chunks are not empty");
+        std::thread::scope(|scope| {
+            let others: Vec<_> = others
+                .iter()
+                .map(|&velocity| {
+                    let mut copy = voice.clone();
+                    scope.spawn(move || {
+                        render_pluck(&mut copy, target, pluck, velocity, sample_rate_hz)
+                    })
+                })
+                .collect();
+            let last = render_pluck(voice, target, pluck, last, sample_rate_hz);
+            for other in others {
+                let signal = other
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+                signals.push(signal);
+            }
+            signals.push(last);
+        });
+    }
+    for (index, signal) in signals.iter().enumerate() {
+        let pitch = sustained_pitch_hz(signal, sample_rate_hz, nominal);
         checked.cents[index] = 1200.0 * (pitch / nominal).log2();
         if index == 0 || index == N - 1 {
-            checked.brightness_db += 0.5 * brightness_db(&signal, sample_rate_hz);
+            checked.brightness_db += 0.5 * brightness_db(signal, sample_rate_hz);
         }
     }
     checked
+}
+
+thread_local! {
+    /// How many plucks of a check this thread's calibrations render at once
+    /// ([`with_plucks_at_once`]).
+    static PLUCKS_AT_ONCE: Cell<usize> = const { Cell::new(MAX_PLUCKS_AT_ONCE) };
+}
+
+/// The most plucks one check renders (the soft end, midway and the firm end), and so the most
+/// it renders at once, each but one on a thread of its own: a calibration's plucks render at once
+/// unless [`with_plucks_at_once`] says otherwise.
+pub const MAX_PLUCKS_AT_ONCE: usize = 3;
+
+/// Runs `work` with this thread's calibrations rendering at most `plucks` (at least 1) of a
+/// check's plucks at once, e.g. 1 for a renderer asked to use one thread. The calibrations are
+/// the same to the bit whatever the number.
+pub fn with_plucks_at_once<R>(plucks: usize, work: impl FnOnce() -> R) -> R {
+    let before = PLUCKS_AT_ONCE.with(|at_once| at_once.replace(plucks.max(1)));
+    // Restored even if `work` panics, so that a caught panic leaves the thread as it was.
+    struct Restore(usize);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            PLUCKS_AT_ONCE.with(|at_once| at_once.set(self.0));
+        }
+    }
+    let _restore = Restore(before);
+    work()
 }
 
 /// The calibration of a string as a player sets it (module doc): the offset that centres its
@@ -733,6 +792,90 @@ impl AsPlayedTuning {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One check after another, each one pluck after another on one voice: what `check` renders
+    /// on its threads, to the bit, at a tier of each kind (modal at the output rate, the fine
+    /// string, the seed's FD) and with its plucks one, two or three at a time, with a moved
+    /// thread in between as the search moves it.
+    #[test]
+    fn a_check_renders_its_plucks_as_one_after_another() {
+        fn in_turn<const N: usize>(
+            voice: &mut TanpuraVoice,
+            nominal: f64,
+            offset_cents: f64,
+            pluck: &Pluck,
+            velocities: [f64; N],
+        ) -> Vec<u64> {
+            let target = nominal * (offset_cents / 1200.0).exp2();
+            let mut bits = Vec::new();
+            for velocity in velocities {
+                let signal = render_pluck(voice, target, pluck, velocity, 44_100.0);
+                let pitch = sustained_pitch_hz(&signal, 44_100.0, nominal);
+                bits.push((1200.0 * (pitch / nominal).log2()).to_bits());
+                bits.push(brightness_db(&signal, 44_100.0).to_bits());
+            }
+            bits
+        }
+        fn threaded<const N: usize>(
+            at_once: usize,
+            voice: &mut TanpuraVoice,
+            nominal: f64,
+            offset_cents: f64,
+            pluck: &Pluck,
+            velocities: [f64; N],
+        ) -> Vec<u64> {
+            let checked = with_plucks_at_once(at_once, || {
+                check(voice, nominal, offset_cents, pluck, velocities, 44_100.0)
+            });
+            checked.cents.iter().map(|cents| cents.to_bits()).collect()
+        }
+        let cases = [
+            (Quality::Live, 1),
+            (Quality::Live, 2),
+            (Quality::Fine, 2),
+            (Quality::Fine, MAX_PLUCKS_AT_ONCE),
+            (Quality::Reference, MAX_PLUCKS_AT_ONCE),
+        ];
+        for (quality, at_once) in cases {
+            let settings = VoiceSettings {
+                quality,
+                fundamental_hz: 146.83,
+                ..VoiceSettings::default()
+            };
+            let pluck = Pluck::default();
+            let moved = VoiceSettings {
+                thread_position_m: settings.thread_position_m + THREAD_STEP_M,
+                ..settings
+            };
+            let (mut one, mut other) = (
+                TanpuraVoice::new(&settings, 44_100.0),
+                TanpuraVoice::new(&settings, 44_100.0),
+            );
+            let nominal = settings.fundamental_hz;
+            let expected = in_turn(&mut one, nominal, 2.0, &pluck, [0.3, 0.9]);
+            let got = threaded(at_once, &mut other, nominal, 2.0, &pluck, [0.3, 0.9]);
+            let cents: Vec<u64> = expected.iter().step_by(2).copied().collect();
+            assert_eq!(
+                got, cents,
+                "{quality:?}, {at_once} at once: the first check"
+            );
+            one.set_settings(&moved);
+            other.set_settings(&moved);
+            let expected = in_turn(&mut one, nominal, -1.0, &pluck, [0.3, 0.6, 0.9]);
+            let got = threaded(at_once, &mut other, nominal, -1.0, &pluck, [0.3, 0.6, 0.9]);
+            let cents: Vec<u64> = expected.iter().step_by(2).copied().collect();
+            assert_eq!(got, cents, "{quality:?}, {at_once} at once: after the move");
+            // And the brightness, which `check` averages over the ends.
+            let checked = check(&mut other, nominal, 0.0, &pluck, [0.3, 0.9], 44_100.0);
+            let ends = in_turn(&mut one, nominal, 0.0, &pluck, [0.3, 0.9]);
+            let brightness = 0.5 * f64::from_bits(ends[1]) + 0.5 * f64::from_bits(ends[3]);
+            assert_eq!(
+                checked.brightness_db.to_bits(),
+                brightness.to_bits(),
+                "{quality:?}"
+            );
+        }
+    }
 
     /// Stop 32's calibration read the note from the voice's settings, which each render leaves at
     /// its own target: the check of a moved thread then rendered the string tuned by the
