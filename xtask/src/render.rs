@@ -607,7 +607,9 @@ pub(crate) struct Tuned {
 /// it is measured there. With `jobs` > 1 the pool has `jobs` threads for the calibrations and the
 /// voices and one more, which drives the render: it hands out each segment's voices and takes
 /// some of them, and when a string it is about to pluck is still being measured it waits, taking
-/// no calibration itself, so that it resumes as soon as that one is done. The calibrations are
+/// no calibration itself, so that it resumes as soon as that one is done; each check of a
+/// calibration renders up to `jobs` of its plucks at once, on threads of its own
+/// (`as_played::with_plucks_at_once`: the same calibration to the bit). The calibrations are
 /// queued in the order their strings are first plucked, so the render of the first notes
 /// proceeds while the later strings are measured. (Stop 58 measured three ways on two cores: the
 /// render on a thread outside the pool paid a pool hand-over per block, 0.79-0.81 s against
