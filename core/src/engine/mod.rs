@@ -22,7 +22,9 @@
 //!   [`SMOOTHING_TIME_S`]; the output gain ramps per sample;
 //! - sample-accurate events: [`Engine::process`] splits the block at every event, control tick
 //!   and drone pluck. All of these sit at absolute sample times, so the output does not depend on
-//!   the block size;
+//!   the block size. Offline ([`Engine::process_with`]) a segment runs on through the control
+//!   ticks that would change nothing, so that its voices run as longer tasks on the threads,
+//!   with the same samples (`Engine::control_ticks_are_idle`);
 //! - the output level: see [`NEWTONS_AT_FULL_SCALE`];
 //! - the boundary with the host: settings pass through [`EngineSettings::clamped`] and events
 //!   through [`EngineEvent::sanitised`], so a non-finite or out-of-range value from automation
