@@ -94,8 +94,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE.png")]
     spectrum: Option<PathBuf>,
     /// Threads that measure the strings' calibrations and run the voices (1 to 256; default: every
-    /// core), besides the one that drives the render when more than one. The output is
-    /// bit-identical for any number.
+    /// core), besides the one that drives the render when more than one; a calibration renders up
+    /// to N of a check's plucks at once, on threads of its own. The output is bit-identical for
+    /// any number.
     #[arg(long, value_name = "N", value_parser = number_in(1usize, 256))]
     jobs: Option<usize>,
     /// Longest render allowed, s (1 to 86400; default one hour): a score whose rendered length
