@@ -24,3 +24,4 @@ pub mod simd;
 pub mod snapshot;
 pub mod snapshot_channel;
 pub mod step_timers;
+mod unroll;

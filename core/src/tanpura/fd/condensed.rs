@@ -37,6 +37,7 @@
 
 use crate::banded::{BandedLdlt, NotPositiveDefinite};
 use crate::tanpura::fd::kernels::Kernels;
+use crate::unroll::{for_each_index, LARGEST_UNROLLED};
 use pulp::{Simd, WithSimd};
 
 /// The contact block `C = first_node..first_node + size`, its Schur complements and the
@@ -323,6 +324,9 @@ impl ContactCondensation {
     /// the seed's grid: 5 to 8), in fixed-size arrays, so that the loops unroll and the factors
     /// stay in registers. The same operations in the same order as the any-size path.
     #[inline(always)]
+    // The written-out loops meet ranges and comparisons that are empty or constant at some
+    // indices; the compiler folds them, as it should.
+    #[allow(clippy::absurd_extreme_comparisons, clippy::reversed_empty_ranges)]
     fn update_fixed<const M: usize>(&mut self, step: &mut [f64], contact: &[f64]) -> Option<f64> {
         let first = self.active_first;
         let offset = first - self.first_node;
@@ -355,43 +359,54 @@ impl ContactCondensation {
             }
             *x = product - force;
         }
-        // LDLᵀ in place (as `ldlt_in_place`: L below the diagonal, 1/D on it), then the solve.
-        for i in 0..M {
-            let mut u = [0.0; M];
-            for j in 0..i {
-                let mut dot = 0.0;
-                for k in 0..j {
-                    dot += u[k] * jacobian[j][k];
+        // LDLᵀ in place (as `ldlt_in_place`: L below the diagonal, 1/D on it), then the solve;
+        // every loop written out at compile time (`crate::unroll`), the same operations in the
+        // same order.
+        const { assert!(M <= LARGEST_UNROLLED) };
+        for_each_index!(ascending I => {
+            if I < M {
+                let mut u = [0.0; M];
+                for_each_index!(ascending J => {
+                    if J < I {
+                        let mut dot = 0.0;
+                        for k in 0..J {
+                            dot += u[k] * jacobian[J][k];
+                        }
+                        u[J] = jacobian[I][J] - dot;
+                    }
+                });
+                let mut diagonal = jacobian[I][I];
+                for j in 0..I {
+                    let l = u[j] * jacobian[j][j];
+                    jacobian[I][j] = l;
+                    diagonal -= u[j] * l;
                 }
-                u[j] = jacobian[i][j] - dot;
+                if diagonal.is_nan() || diagonal <= 0.0 {
+                    return None;
+                }
+                jacobian[I][I] = 1.0 / diagonal;
             }
-            let mut diagonal = jacobian[i][i];
-            for j in 0..i {
-                let l = u[j] * jacobian[j][j];
-                jacobian[i][j] = l;
-                diagonal -= u[j] * l;
+        });
+        for_each_index!(ascending I => {
+            if I < M {
+                let mut dot = 0.0;
+                for j in 0..I {
+                    dot += jacobian[I][j] * solution[j];
+                }
+                solution[I] -= dot;
             }
-            if diagonal.is_nan() || diagonal <= 0.0 {
-                return None;
-            }
-            jacobian[i][i] = 1.0 / diagonal;
-        }
-        for i in 0..M {
-            let mut dot = 0.0;
-            for j in 0..i {
-                dot += jacobian[i][j] * solution[j];
-            }
-            solution[i] -= dot;
-        }
+        });
         for (i, x) in solution.iter_mut().enumerate() {
             *x *= jacobian[i][i];
         }
-        for i in (0..M).rev() {
-            let x = solution[i];
-            for j in 0..i {
-                solution[j] -= jacobian[i][j] * x;
+        for_each_index!(descending I => {
+            if I < M {
+                let x = solution[I];
+                for j in 0..I {
+                    solution[j] -= jacobian[I][j] * x;
+                }
             }
-        }
+        });
         let mut largest = 0.0f64;
         for (s, delta) in block_step.iter_mut().zip(&solution) {
             *s -= delta;

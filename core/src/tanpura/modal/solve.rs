@@ -21,6 +21,7 @@ use super::lanes::{padded_lanes, Kernels};
 use super::modes::MODE_CAPACITY;
 use super::points::ContactPoints;
 use crate::dense::DenseCholesky;
+use crate::unroll::{for_each_index, LARGEST_UNROLLED};
 
 /// Solves `A x = b` in place for the SPD `n × n` matrix whose lower triangle is in `matrix`
 /// (row-major), by an LDLᵀ factorisation written over it: `L` below the diagonal, `D` on it. No
@@ -81,51 +82,69 @@ pub(super) fn ldl_solve_fixed<const N: usize>(matrix: &mut [[f64; N]; N], x: &mu
 /// over whole rows of `N` lanes (the lanes above the column are formed and dropped), which the
 /// compiler vectorises where the row-wise sums stay scalar: on AVX2, 30 M of the 73 M
 /// instructions the factorisations execute in `tier_cost fine 1 1` are 4-wide register
-/// operations (callgrind per instruction, stop 46 in `docs/performance.md`). The substitutions
-/// below stay scalar.
+/// operations (callgrind per instruction, stop 46 in `docs/performance.md`). Every loop is
+/// written out at compile time (`crate::unroll`), for `N` up to 16.
 #[inline(always)]
+// At some indices of the written-out loops a guard is constant; the compiler folds it.
+#[allow(clippy::absurd_extreme_comparisons)]
 pub(super) fn ldl_factor_fixed<const N: usize>(matrix: &mut [[f64; N]; N]) {
-    for j in 0..N {
-        let (done, rest) = matrix.split_at_mut(j);
-        let row_j = &mut rest[0];
-        // Column j less Σ_k L_ik (L_jk d_k), k ascending; its lane j is d_j.
-        let mut column = *row_j;
-        for (k, row_k) in done.iter().enumerate() {
-            let weighted = row_k[j] * row_k[k];
-            for (value, &l) in column.iter_mut().zip(row_k) {
-                *value -= l * weighted;
+    const { assert!(N <= LARGEST_UNROLLED) };
+    let mut rows = *matrix;
+    for_each_index!(ascending J => {
+        if J < N {
+            // Column J less Σ_k L_ik (L_Jk d_k), k ascending; its lane J is d_J.
+            let mut column = rows[J];
+            for_each_index!(ascending K => {
+                if K < J {
+                    let row_k = rows[K];
+                    let weighted = row_k[J] * row_k[K];
+                    for (value, &l) in column.iter_mut().zip(&row_k) {
+                        *value -= l * weighted;
+                    }
+                }
+            });
+            let diagonal = column[J];
+            let inverse = 1.0 / diagonal;
+            let row_j = &mut rows[J];
+            row_j[J] = diagonal;
+            for (target, value) in row_j[J + 1..].iter_mut().zip(&column[J + 1..]) {
+                *target = value * inverse;
             }
         }
-        let diagonal = column[j];
-        let inverse = 1.0 / diagonal;
-        row_j[j] = diagonal;
-        for (target, value) in row_j[j + 1..].iter_mut().zip(&column[j + 1..]) {
-            *target = value * inverse;
-        }
-    }
+    });
+    *matrix = rows;
 }
 
 /// Solves with the factors of [`ldl_factor_fixed`]: `L y = b`, `D z = y`, `Lᵀ x = z`, in place,
-/// each entry's products subtracted one by one in the order of the row-wise substitution.
+/// each entry's products subtracted one by one in the order of the row-wise substitution;
+/// unrolled at compile time as the factorisation is.
 #[inline(always)]
 pub(super) fn ldl_substitute_fixed<const N: usize>(factors: &[[f64; N]; N], x: &mut [f64; N]) {
-    for (k, row) in factors.iter().enumerate() {
-        let solved = x[k];
-        for (i, (value, &l)) in x.iter_mut().zip(row).enumerate() {
-            *value = if i > k { *value - l * solved } else { *value };
+    const { assert!(N <= LARGEST_UNROLLED) };
+    let mut solution = *x;
+    for_each_index!(ascending K => {
+        if K < N {
+            let solved = solution[K];
+            let row = &factors[K];
+            for (i, (value, &l)) in solution.iter_mut().zip(row).enumerate() {
+                *value = if i > K { *value - l * solved } else { *value };
+            }
         }
-    }
-    for (i, value) in x.iter_mut().enumerate() {
+    });
+    for (i, value) in solution.iter_mut().enumerate() {
         *value /= factors[i][i];
     }
-    for (k, row) in factors.iter().enumerate().rev() {
-        let (head, later) = x.split_at_mut(k + 1);
-        head[k] = row[k + 1..]
-            .iter()
-            .zip(later.iter())
-            .rev()
-            .fold(head[k], |value, (&l, &solved)| value - l * solved);
-    }
+    for_each_index!(descending K => {
+        if K < N {
+            let row = &factors[K];
+            let mut value = solution[K];
+            for i in (K + 1..N).rev() {
+                value -= row[i] * solution[i];
+            }
+            solution[K] = value;
+        }
+    });
+    *x = solution;
 }
 
 /// Static equilibrium of the string on a set of points (bridge, thread and maybe finger).
@@ -609,13 +628,12 @@ mod tests {
     }
 
     /// The fixed-lane factorisation by columns over whole rows, and its substitutions, give the
-    /// row-wise loops' solution bit for bit, as their docs say: on a full matrix of 8 lanes and
-    /// on 5 unknowns padded with the identity (the padding solves x = 0), for matrices whose
-    /// entries round in every product.
+    /// row-wise loops' solution bit for bit, as their docs say: on full matrices of 1 to 8 lanes
+    /// and of 16, and on fewer unknowns padded with the identity (the padding solves x = 0), for
+    /// matrices whose entries round in every product.
     #[test]
     fn the_fixed_lane_ldl_is_the_row_wise_one_bit_for_bit() {
-        const LANES: usize = 8;
-        for n in [LANES, 5] {
+        fn check<const LANES: usize>(n: usize) {
             let mut matrix = [[0.0; LANES]; LANES];
             for (b, row) in matrix.iter_mut().enumerate() {
                 for (a, value) in row.iter_mut().enumerate() {
@@ -645,9 +663,22 @@ mod tests {
             assert_eq!(
                 solved.map(f64::to_bits),
                 expected.map(f64::to_bits),
-                "n = {n}"
+                "{LANES} lanes, n = {n}"
             );
             assert!(solved[n..].iter().all(|&v| v == 0.0));
+        }
+        check::<1>(1);
+        check::<2>(2);
+        check::<3>(3);
+        check::<4>(4);
+        check::<5>(5);
+        check::<6>(6);
+        check::<7>(7);
+        for n in [8, 5, 1] {
+            check::<8>(n);
+        }
+        for n in [16, 11, 9] {
+            check::<16>(n);
         }
     }
 
