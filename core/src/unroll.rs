@@ -5,8 +5,10 @@
 //! keeps them in registers, where rolled loops over a run-time column index kept them on the
 //! stack, and each column's vector loads then waited on the previous column's narrower stores.
 //! The written-out loops do the same operations in the same order, so the same bits: an 8 × 8
-//! LDLᵀ took about 115 ns rolled and 30 ns written out on the Xeon of stop 69
-//! (`docs/performance.md`). A body guards itself with `if INDEX < N`, which the compiler folds.
+//! LDLᵀ took about 115 ns rolled and 30 ns written out on the Xeon of stop 69 (a throwaway
+//! timing, not kept; what the tiers gained, measured by `tier_cost` and the bench, is in
+//! `docs/performance.md`, stop 69). A body guards itself with `if INDEX < N`, which the compiler
+//! folds.
 
 /// `for_each_index!(ascending INDEX => { … })` runs the block for INDEX = 0, 1, …, 15;
 /// `for_each_index!(descending INDEX => { … })` for INDEX = 15, 14, …, 0. INDEX is a `usize`
