@@ -52,11 +52,13 @@ use super::modes::{ModeSet, MODE_CAPACITY};
 use super::points::ContactPoints;
 use super::solve::{
     ldl_factor_fixed, ldl_solve_in_place, ldl_substitute_fixed, ldl_substitute_in_place,
+    ldl_substitute_many,
 };
 use crate::newton::NewtonSettings;
 use crate::step_timers::{self, StepPart};
 use crate::tanpura::contact::HuntCrossley;
 use crate::tanpura::fd::barrier_grid::lagrange_stencil;
+use crate::unroll::for_each_index;
 use std::f64::consts::PI;
 
 /// The most grid nodes the stencils may reach; a configuration that reaches more runs the
@@ -904,29 +906,22 @@ impl NodalContact {
     ) -> bool {
         let m = self.set_count;
         if crossings == 1 {
-            let c = self.crossing_points[0];
             let mut direction = [0.0; N];
-            self.crossing_column(c, &mut direction[..m]);
+            self.crossing_column(self.crossing_points[0], &mut direction[..m]);
             substitute(&mut direction);
-            let Some(departure) = self.exact_departure(c, &delta[..m], &direction[..m]) else {
-                return false;
-            };
-            for (d, w) in delta[..m].iter_mut().zip(&direction[..m]) {
-                *d += departure * w;
-            }
-            return true;
+            return self.finish_one_crossing(delta, &direction);
         }
         #[cfg(test)]
         if self.iterate_over_crossings {
             return false;
         }
         match crossings {
-            2 => self.solve_crossings::<N, 2>(&substitute, delta, 2, tolerance_m),
-            3 => self.solve_crossings::<N, 3>(&substitute, delta, 3, tolerance_m),
-            4 => self.solve_crossings::<N, 4>(&substitute, delta, 4, tolerance_m),
-            5 => self.solve_crossings::<N, 5>(&substitute, delta, 5, tolerance_m),
-            6 => self.solve_crossings::<N, 6>(&substitute, delta, 6, tolerance_m),
-            7..=MOST_CROSSINGS => self.solve_crossings::<N, MOST_CROSSINGS>(
+            2 => self.finish_crossings_with::<N, 2>(&substitute, delta, 2, tolerance_m),
+            3 => self.finish_crossings_with::<N, 3>(&substitute, delta, 3, tolerance_m),
+            4 => self.finish_crossings_with::<N, 4>(&substitute, delta, 4, tolerance_m),
+            5 => self.finish_crossings_with::<N, 5>(&substitute, delta, 5, tolerance_m),
+            6 => self.finish_crossings_with::<N, 6>(&substitute, delta, 6, tolerance_m),
+            7..=MOST_CROSSINGS => self.finish_crossings_with::<N, MOST_CROSSINGS>(
                 &substitute,
                 delta,
                 crossings,
@@ -936,8 +931,133 @@ impl NodalContact {
         }
     }
 
-    /// The finish of a step whose `k ≥ 2` crossing points are `crossing_points[..k]`, in
-    /// `K ≥ k` lanes (`docs/modal-tanpura.md`, section 12, "Several crossing points"): with
+    /// The finish of a step with one crossing point, `crossing_points[0]`, given its direction
+    /// `w = A⁻¹ l_c` ([`NodalContact::exact_departure`]). Returns whether it did; `delta` then
+    /// holds `δ + ρ w`.
+    #[inline(always)]
+    fn finish_one_crossing<const N: usize>(
+        &self,
+        delta: &mut [f64; N],
+        direction: &[f64; N],
+    ) -> bool {
+        let m = self.set_count;
+        let c = self.crossing_points[0];
+        let Some(departure) = self.exact_departure(c, &delta[..m], &direction[..m]) else {
+            return false;
+        };
+        for (d, w) in delta[..m].iter_mut().zip(&direction[..m]) {
+            *d += departure * w;
+        }
+        true
+    }
+
+    /// [`NodalContact::solve_crossings`] on the `k` crossing points' columns `l_d` and their
+    /// directions `w_d = A⁻¹ l_d`, each solved by `substitute` (the general path's).
+    #[inline(always)]
+    fn finish_crossings_with<const N: usize, const K: usize>(
+        &self,
+        substitute: &impl Fn(&mut [f64; N]),
+        delta: &mut [f64; N],
+        k: usize,
+        tolerance_m: f64,
+    ) -> bool {
+        let m = self.set_count;
+        let mut columns = [[0.0; N]; K];
+        let mut directions = [[0.0; N]; K];
+        for ((column, direction), &point) in columns
+            .iter_mut()
+            .zip(&mut directions)
+            .zip(&self.crossing_points[..k])
+        {
+            self.crossing_column(point, &mut column[..m]);
+            *direction = *column;
+            substitute(direction);
+        }
+        self.solve_crossings::<N, K>(&columns, &directions, delta, k, tolerance_m)
+    }
+
+    /// Newton's update substituted through the fixed-lane factors `factors`, and the step
+    /// finished where its evaluation found `crossings` points crossing
+    /// ([`NodalContact::finish_step`]): the update and the crossing points' directions
+    /// `w_d = A⁻¹ l_d` are substituted together ([`ldl_substitute_many`], one right side per
+    /// vector, the same bits as one by one), so that their dependency chains overlap. Returns
+    /// whether the step was finished; `delta` holds Newton's update, or the finished one.
+    #[inline(always)]
+    fn substitute_and_finish<const N: usize>(
+        &self,
+        factors: &[[f64; N]; N],
+        delta: &mut [f64; N],
+        crossings: usize,
+        tolerance_m: f64,
+    ) -> bool {
+        #[cfg(test)]
+        let crossings = if self.iterate_over_crossings && crossings > 1 {
+            0
+        } else {
+            crossings
+        };
+        match crossings {
+            1 => self.finish_in_lanes::<N, 1, 2>(factors, delta, 1, tolerance_m),
+            2 => self.finish_in_lanes::<N, 2, 3>(factors, delta, 2, tolerance_m),
+            3 => self.finish_in_lanes::<N, 3, 4>(factors, delta, 3, tolerance_m),
+            4 => self.finish_in_lanes::<N, 4, 5>(factors, delta, 4, tolerance_m),
+            5 => self.finish_in_lanes::<N, 5, 6>(factors, delta, 5, tolerance_m),
+            6 => self.finish_in_lanes::<N, 6, 7>(factors, delta, 6, tolerance_m),
+            7..=MOST_CROSSINGS => self
+                .finish_in_lanes::<N, MOST_CROSSINGS, { MOST_CROSSINGS + 1 }>(
+                    factors,
+                    delta,
+                    crossings,
+                    tolerance_m,
+                ),
+            _ => {
+                let time = step_timers::start();
+                ldl_substitute_fixed(factors, delta);
+                step_timers::add(StepPart::Substitute, time);
+                false
+            }
+        }
+    }
+
+    /// [`NodalContact::substitute_and_finish`] for `1 ≤ k ≤ K` crossing points in `K` lanes
+    /// (`R = K + 1` right sides: Newton's update, then one direction per lane; the lanes past k
+    /// substitute zeros, and their directions are kept exactly zero, as the finish one by one
+    /// leaves them).
+    #[inline(always)]
+    fn finish_in_lanes<const N: usize, const K: usize, const R: usize>(
+        &self,
+        factors: &[[f64; N]; N],
+        delta: &mut [f64; N],
+        k: usize,
+        tolerance_m: f64,
+    ) -> bool {
+        const { assert!(R == K + 1) };
+        let time = step_timers::start();
+        let m = self.set_count;
+        let mut columns = [[0.0; N]; K];
+        for (column, &point) in columns.iter_mut().zip(&self.crossing_points[..k]) {
+            self.crossing_column(point, &mut column[..m]);
+        }
+        let mut sides = [[0.0; N]; R];
+        sides[0] = *delta;
+        sides[1..].copy_from_slice(&columns);
+        ldl_substitute_many(factors, &mut sides);
+        *delta = sides[0];
+        let mut directions = [[0.0; N]; K];
+        directions[..k].copy_from_slice(&sides[1..=k]);
+        let time = step_timers::add(StepPart::Substitute, time);
+        let finished = if k == 1 {
+            self.finish_one_crossing(delta, &directions[0])
+        } else {
+            self.solve_crossings::<N, K>(&columns, &directions, delta, k, tolerance_m)
+        };
+        step_timers::add(StepPart::FinishCrossings, time);
+        finished
+    }
+
+    /// The finish of a step whose `k ≥ 2` crossing points are `crossing_points[..k]`, given
+    /// each one's column `l_d` on S (`columns`) and `w_d = A⁻¹ l_d` (`directions`; zero past k),
+    /// in `K ≥ k` lanes (`docs/modal-tanpura.md`, section 12, "Several crossing points"): with
     /// every other point in a linear case, `A (Δy − Δy⁰) = ρ_N + Σ_d l_d ρ_d(s_d)`, so
     /// `Δy = Δy⁰ + δ + Σ_d ρ_d w_d` with `w_d = A⁻¹ l_d`, and the k crossing points' steps solve
     ///
@@ -955,23 +1075,19 @@ impl NodalContact {
     /// Each iteration costs O(K³) on a few registers, against an update on S (the evaluation
     /// of every tracked point, the stiffness sums and the factorisation) that it replaces.
     #[inline(always)]
+    // At some indices of the written-out loops a guard or a range is constant; the compiler
+    // folds it.
+    #[allow(clippy::absurd_extreme_comparisons, clippy::reversed_empty_ranges)]
     fn solve_crossings<const N: usize, const K: usize>(
         &self,
-        substitute: &impl Fn(&mut [f64; N]),
+        columns: &[[f64; N]; K],
+        directions: &[[f64; N]; K],
         delta: &mut [f64; N],
         k: usize,
         tolerance_m: f64,
     ) -> bool {
         let m = self.set_count;
         let points = &self.crossing_points[..k];
-        // Each point's l_d on S, and w_d = A⁻¹ l_d.
-        let mut columns = [[0.0; N]; K];
-        let mut directions = [[0.0; N]; K];
-        for ((column, direction), &point) in columns.iter_mut().zip(&mut directions).zip(points) {
-            self.crossing_column(point, &mut column[..m]);
-            *direction = *column;
-            substitute(direction);
-        }
         let dot = |a: &[f64; N], b: &[f64; N]| -> f64 { a.iter().zip(b).map(|(x, y)| x * y).sum() };
         let mut coupling = [[0.0; K]; K];
         let mut newton_steps = [0.0; K];
@@ -1016,33 +1132,41 @@ impl NodalContact {
                 jacobian[c][c] += 1.0;
                 residual[c] = value;
             }
+            // Gaussian elimination and back substitution, written out at compile time
+            // (`crate::unroll`) so that the K × K system stays in registers.
             let mut smallest_pivot = f64::INFINITY;
-            for column in 0..K {
-                let pivot = jacobian[column][column];
-                smallest_pivot = smallest_pivot.min(pivot);
-                let inverse = 1.0 / pivot;
-                for row in column + 1..K {
-                    let factor = jacobian[row][column] * inverse;
-                    for entry in column + 1..K {
-                        jacobian[row][entry] -= factor * jacobian[column][entry];
-                    }
-                    residual[row] -= factor * residual[column];
+            for_each_index!(ascending COLUMN => {
+                if COLUMN < K {
+                    let pivot = jacobian[COLUMN][COLUMN];
+                    smallest_pivot = smallest_pivot.min(pivot);
+                    let inverse = 1.0 / pivot;
+                    for_each_index!(ascending ROW => {
+                        if COLUMN < ROW && ROW < K {
+                            let factor = jacobian[ROW][COLUMN] * inverse;
+                            for entry in COLUMN + 1..K {
+                                jacobian[ROW][entry] -= factor * jacobian[COLUMN][entry];
+                            }
+                            residual[ROW] -= factor * residual[COLUMN];
+                        }
+                    });
                 }
-            }
+            });
             // Also ends it on a NaN pivot.
             if smallest_pivot.is_nan() || smallest_pivot <= 0.0 {
                 return false;
             }
             let mut largest = 0.0f64;
-            for row in (0..K).rev() {
-                let mut value = residual[row];
-                for entry in row + 1..K {
-                    value -= jacobian[row][entry] * residual[entry];
+            for_each_index!(descending ROW => {
+                if ROW < K {
+                    let mut value = residual[ROW];
+                    for entry in ROW + 1..K {
+                        value -= jacobian[ROW][entry] * residual[entry];
+                    }
+                    residual[ROW] = value / jacobian[ROW][ROW];
+                    steps[ROW] -= residual[ROW];
+                    largest = largest.max(residual[ROW].abs());
                 }
-                residual[row] = value / jacobian[row][row];
-                steps[row] -= residual[row];
-                largest = largest.max(residual[row].abs());
-            }
+            });
             if !largest.is_finite() {
                 return false;
             }
@@ -1051,7 +1175,7 @@ impl NodalContact {
         if !converged || departures.iter().any(|departure| !departure.is_finite()) {
             return false;
         }
-        for (departure, direction) in departures.iter().zip(&directions) {
+        for (departure, direction) in departures.iter().zip(directions) {
             for (value, &w) in delta[..m].iter_mut().zip(direction) {
                 *value += departure * w;
             }
@@ -1105,17 +1229,8 @@ impl NodalContact {
         self.add_stiffnesses_fixed(&mut matrix);
         let time = step_timers::add(StepPart::UpdateSetup, time);
         ldl_factor_fixed(&mut matrix);
-        let time = step_timers::add(StepPart::Factorise, time);
-        ldl_substitute_fixed(&matrix, &mut delta);
-        let time = step_timers::add(StepPart::Substitute, time);
-        let finished = crossings > 0
-            && self.finish_step(
-                |x: &mut [f64; N]| ldl_substitute_fixed(&matrix, x),
-                &mut delta,
-                crossings,
-                tolerance_m,
-            );
-        step_timers::add(StepPart::FinishCrossings, time);
+        step_timers::add(StepPart::Factorise, time);
+        let finished = self.substitute_and_finish(&matrix, &mut delta, crossings, tolerance_m);
         (self.apply_update(&delta[..m]), finished)
     }
 

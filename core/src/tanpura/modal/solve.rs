@@ -147,6 +147,58 @@ pub(super) fn ldl_substitute_fixed<const N: usize>(factors: &[[f64; N]; N], x: &
     *x = solution;
 }
 
+/// [`ldl_substitute_fixed`] on `R` right sides at once: each right side takes the same
+/// operations in the same order as alone (the same bits), but the loops over the rows are
+/// written out with the right sides innermost, so their dependency chains (each row waits on
+/// the one before it) overlap instead of following each other. The exact finish of a step with
+/// crossing points substitutes Newton's update and one direction per crossing point through the
+/// same factors (`nodal.rs`, `NodalContact::update_in_lanes`).
+#[inline(always)]
+// At some indices of the written-out loops a guard is constant; the compiler folds it.
+#[allow(clippy::absurd_extreme_comparisons)]
+pub(super) fn ldl_substitute_many<const N: usize, const R: usize>(
+    factors: &[[f64; N]; N],
+    right_sides: &mut [[f64; N]; R],
+) {
+    const { assert!(N <= LARGEST_UNROLLED && R <= LARGEST_UNROLLED) };
+    let mut solutions = *right_sides;
+    for_each_index!(ascending K => {
+        if K < N {
+            let row = &factors[K];
+            for_each_index!(ascending SIDE => {
+                if SIDE < R {
+                    let solution = &mut solutions[SIDE];
+                    let solved = solution[K];
+                    for (i, (value, &l)) in solution.iter_mut().zip(row).enumerate() {
+                        *value = if i > K { *value - l * solved } else { *value };
+                    }
+                }
+            });
+        }
+    });
+    for solution in solutions.iter_mut() {
+        for (i, value) in solution.iter_mut().enumerate() {
+            *value /= factors[i][i];
+        }
+    }
+    for_each_index!(descending K => {
+        if K < N {
+            let row = &factors[K];
+            for_each_index!(ascending SIDE => {
+                if SIDE < R {
+                    let solution = &mut solutions[SIDE];
+                    let mut value = solution[K];
+                    for i in (K + 1..N).rev() {
+                        value -= row[i] * solution[i];
+                    }
+                    solution[K] = value;
+                }
+            });
+        }
+    });
+    *right_sides = solutions;
+}
+
 /// Static equilibrium of the string on a set of points (bridge, thread and maybe finger).
 #[derive(Debug, Clone)]
 pub struct StaticSolver {
@@ -680,6 +732,48 @@ mod tests {
         for n in [16, 11, 9] {
             check::<16>(n);
         }
+    }
+
+    #[test]
+    fn many_right_sides_substitute_as_each_alone_bit_for_bit() {
+        fn check<const LANES: usize, const SIDES: usize>(n: usize) {
+            let mut matrix: [[f64; LANES]; LANES] = std::array::from_fn(|b| {
+                std::array::from_fn(|a| match (a < n && b < n, a == b) {
+                    (true, true) => 2.7 + 0.4 * a as f64,
+                    (true, false) => 0.8 / (1.5 + a as f64 + 2.0 * b as f64),
+                    (false, diagonal) => diagonal as u8 as f64,
+                })
+            });
+            ldl_factor_fixed(&mut matrix);
+            let sides: [[f64; LANES]; SIDES] = std::array::from_fn(|side| {
+                std::array::from_fn(|i| {
+                    if i < n {
+                        (0.9 * i as f64 + 1.7 * side as f64 - 0.4).cos()
+                    } else {
+                        0.0
+                    }
+                })
+            });
+            let mut together = sides;
+            ldl_substitute_many(&matrix, &mut together);
+            for (side, (alone, solved)) in sides.iter().zip(&together).enumerate() {
+                let mut alone = *alone;
+                ldl_substitute_fixed(&matrix, &mut alone);
+                assert_eq!(
+                    solved.map(f64::to_bits),
+                    alone.map(f64::to_bits),
+                    "{LANES} lanes, n = {n}, right side {side} of {SIDES}"
+                );
+                assert!(solved[..n].iter().any(|&v| v != 0.0));
+            }
+        }
+        check::<8, 1>(8);
+        check::<8, 2>(7);
+        check::<8, 3>(5);
+        check::<8, 9>(8);
+        check::<16, 2>(16);
+        check::<16, 5>(11);
+        check::<16, 9>(9);
     }
 
     #[test]
