@@ -6,7 +6,8 @@
 //! grid's nodes (`javari_core::step_timers`): cycles per output sample for each part, its share
 //! of the whole run's cycles, and what the parts leave ("rest": the pickups, the decimator, the
 //! step's untimed lines). The counters cost a little themselves (about 20 cycles a read), so the
-//! real-time factor printed is below `tier_cost`'s.
+//! real-time factor printed is below `tier_cost`'s. It fails (exit status 1) if a key's run
+//! counted no time in any part, so CI runs it briefly as the check that the counters count.
 
 use javari_core::engine::pitch::note_to_hz;
 use javari_core::step_timers::{self, STEP_PARTS};
@@ -51,6 +52,12 @@ fn main() {
         let cycles = step_timers::start().wrapping_sub(counter) as f64;
         let factor = samples / SAMPLE_RATE / wall.elapsed().as_secs_f64();
         let totals = step_timers::totals();
+        if totals.iter().all(|&total| total == 0) {
+            eprintln!(
+                "key {key}: no part counted any time (built without `--features step-timers`?)"
+            );
+            std::process::exit(1);
+        }
         print!("{key:>4} {factor:>7.2}x {:>7.0}", cycles / samples);
         for total in totals {
             let share = 100.0 * total as f64 / cycles;

@@ -7,8 +7,17 @@
 //! The written-out loops do the same operations in the same order, so the same bits: an 8 × 8
 //! LDLᵀ took about 115 ns rolled and 30 ns written out on the Xeon of stop 69 (a throwaway
 //! timing, not kept; what the tiers gained, measured by `tier_cost` and the bench, is in
-//! `docs/performance.md`, stop 69). A body guards itself with `if INDEX < N`, which the compiler
-//! folds.
+//! `docs/performance.md`, stop 69).
+//!
+//! A body guards itself with `if const { INDEX < N }`. The guard is a constant evaluated when the
+//! function is instantiated for its `N`, so the code generator emits only the bodies that run;
+//! a run-time `if INDEX < N` (folded only later, by LLVM) handed LLVM all 16 bodies of a loop,
+//! 256 of two nested loops, each copy of the function. And the fine tier's finishes of two or
+//! more crossing points are kept out of line (`modal/nodal.rs`, `finish_out_of_line`), one
+//! function per size, so that the step is not one function holding every size's kernels:
+//! LLVM's time on a function grows faster than its size. The guards change nothing but the
+//! compile time; the calls cost the fine tier a few per cent, measured with what the build
+//! saved in `docs/performance.md`, stop 71.
 
 /// `for_each_index!(ascending INDEX => { … })` runs the block for INDEX = 0, 1, …, 15;
 /// `for_each_index!(descending INDEX => { … })` for INDEX = 15, 14, …, 0. INDEX is a `usize`

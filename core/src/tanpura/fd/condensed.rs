@@ -364,10 +364,10 @@ impl ContactCondensation {
         // same order.
         const { assert!(M <= LARGEST_UNROLLED) };
         for_each_index!(ascending I => {
-            if I < M {
+            if const { I < M } {
                 let mut u = [0.0; M];
                 for_each_index!(ascending J => {
-                    if J < I {
+                    if const { J < I } {
                         let mut dot = 0.0;
                         for k in 0..J {
                             dot += u[k] * jacobian[J][k];
@@ -388,7 +388,7 @@ impl ContactCondensation {
             }
         });
         for_each_index!(ascending I => {
-            if I < M {
+            if const { I < M } {
                 let mut dot = 0.0;
                 for j in 0..I {
                     dot += jacobian[I][j] * solution[j];
@@ -400,7 +400,7 @@ impl ContactCondensation {
             *x *= jacobian[i][i];
         }
         for_each_index!(descending I => {
-            if I < M {
+            if const { I < M } {
                 let x = solution[I];
                 for j in 0..I {
                     solution[j] -= jacobian[I][j] * x;

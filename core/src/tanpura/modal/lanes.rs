@@ -21,6 +21,7 @@
 //! render is bit-identical run to run; two machines with different vector units may differ at
 //! round-off.
 
+use super::ModalString;
 pub use crate::simd::Kernels;
 use pulp::{Simd, WithSimd};
 use std::fmt::Debug;
@@ -56,6 +57,14 @@ pub trait Real: Copy + Default + Debug + PartialEq + Send + Sync + 'static {
         c: Self::Lanes<S>,
     ) -> Self::Lanes<S>;
     fn sum<S: Simd>(simd: S, a: Self::Lanes<S>) -> Self;
+
+    /// [`ModalString::step`] for this type: compiled once, in this crate. The step is generic
+    /// over the type, and a generic function is compiled again in every crate that calls it
+    /// (each example, test and tool built with optimisation); this non-generic function in the
+    /// type's implementation is the one they all call instead.
+    fn step_string(string: &mut ModalString<Self>);
+    /// [`ModalString::step_into`] for this type, compiled once as [`Real::step_string`] is.
+    fn step_string_into(string: &mut ModalString<Self>, output: &mut [f32], nut_weight: f64);
 }
 
 macro_rules! impl_real {
@@ -112,6 +121,18 @@ macro_rules! impl_real {
             #[inline(always)]
             fn sum<S: Simd>(simd: S, a: Self::Lanes<S>) -> Self {
                 simd.$sum(a)
+            }
+            #[inline(never)]
+            fn step_string(string: &mut ModalString<Self>) {
+                string.dispatch_step();
+            }
+            #[inline(never)]
+            fn step_string_into(
+                string: &mut ModalString<Self>,
+                output: &mut [f32],
+                nut_weight: f64,
+            ) {
+                string.dispatch_step_into(output, nut_weight);
             }
         }
     };

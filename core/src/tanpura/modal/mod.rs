@@ -925,6 +925,11 @@ impl<T: Real> ModalString<T> {
     /// never panics. The whole step (dot products, contact solve, mode update) runs as one
     /// function compiled for the machine's vector unit.
     pub fn step(&mut self) {
+        T::step_string(self);
+    }
+
+    /// [`ModalString::step`]'s body, instantiated in this crate only ([`Real::step_string`]).
+    fn dispatch_step(&mut self) {
         let kernels = self.kernels;
         kernels.arch.dispatch(WholeStep { string: self });
     }
@@ -933,6 +938,12 @@ impl<T: Real> ModalString<T> {
     /// ([`weighted_pickup_n`] with `nut_weight`, N) as f32: one dispatch to the vector unit for
     /// the whole run.
     pub fn step_into(&mut self, output: &mut [f32], nut_weight: f64) {
+        T::step_string_into(self, output, nut_weight);
+    }
+
+    /// [`ModalString::step_into`]'s body, instantiated in this crate only
+    /// ([`Real::step_string_into`]).
+    fn dispatch_step_into(&mut self, output: &mut [f32], nut_weight: f64) {
         let kernels = self.kernels;
         kernels.arch.dispatch(StepRun {
             string: self,

@@ -953,7 +953,8 @@ impl NodalContact {
 
     /// [`NodalContact::solve_crossings`] on the `k` crossing points' columns `l_d` and their
     /// directions `w_d = A⁻¹ l_d`, each solved by `substitute` (the general path's).
-    #[inline(always)]
+    // Out of line: one function per size, not all sizes in the step (`crate::unroll`).
+    #[inline(never)]
     fn finish_crossings_with<const N: usize, const K: usize>(
         &self,
         substitute: &impl Fn(&mut [f64; N]),
@@ -998,13 +999,13 @@ impl NodalContact {
         };
         match crossings {
             1 => self.finish_in_lanes::<N, 1, 2>(factors, delta, 1, tolerance_m),
-            2 => self.finish_in_lanes::<N, 2, 3>(factors, delta, 2, tolerance_m),
-            3 => self.finish_in_lanes::<N, 3, 4>(factors, delta, 3, tolerance_m),
-            4 => self.finish_in_lanes::<N, 4, 5>(factors, delta, 4, tolerance_m),
-            5 => self.finish_in_lanes::<N, 5, 6>(factors, delta, 5, tolerance_m),
-            6 => self.finish_in_lanes::<N, 6, 7>(factors, delta, 6, tolerance_m),
+            2 => self.finish_out_of_line::<N, 2, 3>(factors, delta, 2, tolerance_m),
+            3 => self.finish_out_of_line::<N, 3, 4>(factors, delta, 3, tolerance_m),
+            4 => self.finish_out_of_line::<N, 4, 5>(factors, delta, 4, tolerance_m),
+            5 => self.finish_out_of_line::<N, 5, 6>(factors, delta, 5, tolerance_m),
+            6 => self.finish_out_of_line::<N, 6, 7>(factors, delta, 6, tolerance_m),
             7..=MOST_CROSSINGS => self
-                .finish_in_lanes::<N, MOST_CROSSINGS, { MOST_CROSSINGS + 1 }>(
+                .finish_out_of_line::<N, MOST_CROSSINGS, { MOST_CROSSINGS + 1 }>(
                     factors,
                     delta,
                     crossings,
@@ -1017,6 +1018,22 @@ impl NodalContact {
                 false
             }
         }
+    }
+
+    /// [`NodalContact::finish_in_lanes`] for two or more crossing points, kept out of line: one
+    /// function per size. With every size written into the step, the step was one function
+    /// holding them all, and LLVM (whose time on a function grows faster than its size) took
+    /// 16 minutes over the core's release build (`crate::unroll`, `docs/performance.md`,
+    /// stop 71). The finish of one crossing point stays written into the step.
+    #[inline(never)]
+    fn finish_out_of_line<const N: usize, const K: usize, const R: usize>(
+        &self,
+        factors: &[[f64; N]; N],
+        delta: &mut [f64; N],
+        k: usize,
+        tolerance_m: f64,
+    ) -> bool {
+        self.finish_in_lanes::<N, K, R>(factors, delta, k, tolerance_m)
     }
 
     /// [`NodalContact::substitute_and_finish`] for `1 ≤ k ≤ K` crossing points in `K` lanes
@@ -1136,12 +1153,12 @@ impl NodalContact {
             // (`crate::unroll`) so that the K × K system stays in registers.
             let mut smallest_pivot = f64::INFINITY;
             for_each_index!(ascending COLUMN => {
-                if COLUMN < K {
+                if const { COLUMN < K } {
                     let pivot = jacobian[COLUMN][COLUMN];
                     smallest_pivot = smallest_pivot.min(pivot);
                     let inverse = 1.0 / pivot;
                     for_each_index!(ascending ROW => {
-                        if COLUMN < ROW && ROW < K {
+                        if const { COLUMN < ROW && ROW < K } {
                             let factor = jacobian[ROW][COLUMN] * inverse;
                             for entry in COLUMN + 1..K {
                                 jacobian[ROW][entry] -= factor * jacobian[COLUMN][entry];
@@ -1157,7 +1174,7 @@ impl NodalContact {
             }
             let mut largest = 0.0f64;
             for_each_index!(descending ROW => {
-                if ROW < K {
+                if const { ROW < K } {
                     let mut value = residual[ROW];
                     for entry in ROW + 1..K {
                         value -= jacobian[ROW][entry] * residual[entry];

@@ -91,11 +91,11 @@ pub(super) fn ldl_factor_fixed<const N: usize>(matrix: &mut [[f64; N]; N]) {
     const { assert!(N <= LARGEST_UNROLLED) };
     let mut rows = *matrix;
     for_each_index!(ascending J => {
-        if J < N {
+        if const { J < N } {
             // Column J less Σ_k L_ik (L_Jk d_k), k ascending; its lane J is d_J.
             let mut column = rows[J];
             for_each_index!(ascending K => {
-                if K < J {
+                if const { K < J } {
                     let row_k = rows[K];
                     let weighted = row_k[J] * row_k[K];
                     for (value, &l) in column.iter_mut().zip(&row_k) {
@@ -123,7 +123,7 @@ pub(super) fn ldl_substitute_fixed<const N: usize>(factors: &[[f64; N]; N], x: &
     const { assert!(N <= LARGEST_UNROLLED) };
     let mut solution = *x;
     for_each_index!(ascending K => {
-        if K < N {
+        if const { K < N } {
             let solved = solution[K];
             let row = &factors[K];
             for (i, (value, &l)) in solution.iter_mut().zip(row).enumerate() {
@@ -135,7 +135,7 @@ pub(super) fn ldl_substitute_fixed<const N: usize>(factors: &[[f64; N]; N], x: &
         *value /= factors[i][i];
     }
     for_each_index!(descending K => {
-        if K < N {
+        if const { K < N } {
             let row = &factors[K];
             let mut value = solution[K];
             for i in (K + 1..N).rev() {
@@ -163,10 +163,10 @@ pub(super) fn ldl_substitute_many<const N: usize, const R: usize>(
     const { assert!(N <= LARGEST_UNROLLED && R <= LARGEST_UNROLLED) };
     let mut solutions = *right_sides;
     for_each_index!(ascending K => {
-        if K < N {
+        if const { K < N } {
             let row = &factors[K];
             for_each_index!(ascending SIDE => {
-                if SIDE < R {
+                if const { SIDE < R } {
                     let solution = &mut solutions[SIDE];
                     let solved = solution[K];
                     for (i, (value, &l)) in solution.iter_mut().zip(row).enumerate() {
@@ -182,10 +182,10 @@ pub(super) fn ldl_substitute_many<const N: usize, const R: usize>(
         }
     }
     for_each_index!(descending K => {
-        if K < N {
+        if const { K < N } {
             let row = &factors[K];
             for_each_index!(ascending SIDE => {
-                if SIDE < R {
+                if const { SIDE < R } {
                     let solution = &mut solutions[SIDE];
                     let mut value = solution[K];
                     for i in (K + 1..N).rev() {
