@@ -14,10 +14,10 @@
 //! a run-time `if INDEX < N` (folded only later, by LLVM) handed LLVM all 16 bodies of a loop,
 //! 256 of two nested loops, each copy of the function. And the fine tier's finishes of two or
 //! more crossing points are kept out of line (`modal/nodal.rs`, `finish_out_of_line`), one
-//! function per size, so that the step is not one function holding every size's kernels:
-//! LLVM's time on a function grows faster than its size. The guards change nothing but the
-//! compile time; the calls cost the fine tier a few per cent, measured with what the build
-//! saved in `docs/performance.md`, stop 71.
+//! function per size and vector unit, so that the step is not one function holding every
+//! size's kernels: LLVM's time on a function grows faster than its size. The guards change
+//! nothing but the compile time; the calls cost the fine tier up to 4 %, measured with what the
+//! build saved in `docs/performance.md`, stop 71.
 
 /// `for_each_index!(ascending INDEX => { … })` runs the block for INDEX = 0, 1, …, 15;
 /// `for_each_index!(descending INDEX => { … })` for INDEX = 15, 14, …, 0. INDEX is a `usize`

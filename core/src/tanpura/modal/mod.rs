@@ -1082,6 +1082,7 @@ impl<T: Real> ModalString<T> {
         .with_simd(simd);
         step_timers::add(StepPart::NodeDots, time);
         let outcome = self.nodal.step(
+            simd,
             &self.config.newton,
             self.config.track_energy,
             TRACKING_BAND_M,

@@ -59,6 +59,7 @@ use crate::step_timers::{self, StepPart};
 use crate::tanpura::contact::HuntCrossley;
 use crate::tanpura::fd::barrier_grid::lagrange_stencil;
 use crate::unroll::for_each_index;
+use pulp::{Simd, WithSimd};
 use std::f64::consts::PI;
 
 /// The most grid nodes the stencils may reach; a configuration that reaches more runs the
@@ -804,7 +805,7 @@ impl NodalContact {
 
     /// Newton's iteration on S from the iterate in `slot_steps`. Returns (updates, converged).
     #[inline(always)]
-    fn newton(&mut self, settings: &NewtonSettings) -> (u32, bool) {
+    fn newton<S: Simd>(&mut self, simd: S, settings: &NewtonSettings) -> (u32, bool) {
         let mut time = step_timers::start();
         let (_, _, mut crossings) = self.evaluate();
         time = step_timers::add(StepPart::Evaluate, time);
@@ -828,8 +829,8 @@ impl NodalContact {
             // `NodalContact::solve_crossings`).
             let tolerance_m = settings.tolerance_m;
             let (largest, finished) = match size {
-                0..=8 => self.update_in_lanes::<8>(crossings, tolerance_m),
-                9..=16 => self.update_in_lanes::<16>(crossings, tolerance_m),
+                0..=8 => self.update_in_lanes::<S, 8>(simd, crossings, tolerance_m),
+                9..=16 => self.update_in_lanes::<S, 16>(simd, crossings, tolerance_m),
                 _ => self.update_general(crossings, tolerance_m),
             };
             updates += 1;
@@ -984,8 +985,9 @@ impl NodalContact {
     /// vector, the same bits as one by one), so that their dependency chains overlap. Returns
     /// whether the step was finished; `delta` holds Newton's update, or the finished one.
     #[inline(always)]
-    fn substitute_and_finish<const N: usize>(
+    fn substitute_and_finish<S: Simd, const N: usize>(
         &self,
+        simd: S,
         factors: &[[f64; N]; N],
         delta: &mut [f64; N],
         crossings: usize,
@@ -999,13 +1001,14 @@ impl NodalContact {
         };
         match crossings {
             1 => self.finish_in_lanes::<N, 1, 2>(factors, delta, 1, tolerance_m),
-            2 => self.finish_out_of_line::<N, 2, 3>(factors, delta, 2, tolerance_m),
-            3 => self.finish_out_of_line::<N, 3, 4>(factors, delta, 3, tolerance_m),
-            4 => self.finish_out_of_line::<N, 4, 5>(factors, delta, 4, tolerance_m),
-            5 => self.finish_out_of_line::<N, 5, 6>(factors, delta, 5, tolerance_m),
-            6 => self.finish_out_of_line::<N, 6, 7>(factors, delta, 6, tolerance_m),
+            2 => self.finish_out_of_line::<S, N, 2, 3>(simd, factors, delta, 2, tolerance_m),
+            3 => self.finish_out_of_line::<S, N, 3, 4>(simd, factors, delta, 3, tolerance_m),
+            4 => self.finish_out_of_line::<S, N, 4, 5>(simd, factors, delta, 4, tolerance_m),
+            5 => self.finish_out_of_line::<S, N, 5, 6>(simd, factors, delta, 5, tolerance_m),
+            6 => self.finish_out_of_line::<S, N, 6, 7>(simd, factors, delta, 6, tolerance_m),
             7..=MOST_CROSSINGS => self
-                .finish_out_of_line::<N, MOST_CROSSINGS, { MOST_CROSSINGS + 1 }>(
+                .finish_out_of_line::<S, N, MOST_CROSSINGS, { MOST_CROSSINGS + 1 }>(
+                    simd,
                     factors,
                     delta,
                     crossings,
@@ -1021,19 +1024,29 @@ impl NodalContact {
     }
 
     /// [`NodalContact::finish_in_lanes`] for two or more crossing points, kept out of line: one
-    /// function per size. With every size written into the step, the step was one function
-    /// holding them all, and LLVM (whose time on a function grows faster than its size) took
-    /// 16 minutes over the core's release build (`crate::unroll`, `docs/performance.md`,
-    /// stop 71). The finish of one crossing point stays written into the step.
+    /// function per size and vector unit. With every size written into the step, the step was
+    /// one function holding them all, and LLVM (whose time on a function grows faster than its
+    /// size) took 16 minutes over the core's release build (`crate::unroll`,
+    /// `docs/performance.md`, stop 71). The finish of one crossing point stays written into the
+    /// step. The call goes through [`Simd::vectorize`], so the finish out of line is compiled for
+    /// the step's vector unit `simd`, as it was in the step: a plain call compiles it for the
+    /// build's baseline (SSE2 on x86-64), which cost the fine tier 3–9 %.
     #[inline(never)]
-    fn finish_out_of_line<const N: usize, const K: usize, const R: usize>(
+    fn finish_out_of_line<S: Simd, const N: usize, const K: usize, const R: usize>(
         &self,
+        simd: S,
         factors: &[[f64; N]; N],
         delta: &mut [f64; N],
         k: usize,
         tolerance_m: f64,
     ) -> bool {
-        self.finish_in_lanes::<N, K, R>(factors, delta, k, tolerance_m)
+        simd.vectorize(FinishInLanes::<N, K, R> {
+            contact: self,
+            factors,
+            delta,
+            k,
+            tolerance_m,
+        })
     }
 
     /// [`NodalContact::substitute_and_finish`] for `1 ≤ k ≤ K` crossing points in `K` lanes
@@ -1206,8 +1219,9 @@ impl NodalContact {
     /// finished where its evaluation found `crossings` points crossing
     /// ([`NodalContact::finish_step`]).
     #[inline(always)]
-    fn update_in_lanes<const N: usize>(
+    fn update_in_lanes<S: Simd, const N: usize>(
         &mut self,
+        simd: S,
         crossings: usize,
         tolerance_m: f64,
     ) -> (f64, bool) {
@@ -1247,7 +1261,8 @@ impl NodalContact {
         let time = step_timers::add(StepPart::UpdateSetup, time);
         ldl_factor_fixed(&mut matrix);
         step_timers::add(StepPart::Factorise, time);
-        let finished = self.substitute_and_finish(&matrix, &mut delta, crossings, tolerance_m);
+        let finished =
+            self.substitute_and_finish(simd, &matrix, &mut delta, crossings, tolerance_m);
         (self.apply_update(&delta[..m]), finished)
     }
 
@@ -1346,8 +1361,9 @@ impl NodalContact {
     /// move and the tracking follows (`band_m`, `release_m`). Leaves the nodal force changes in
     /// [`NodalContact::loaded`].
     #[inline(always)]
-    pub fn step(
+    pub fn step<S: Simd>(
         &mut self,
+        simd: S,
         settings: &NewtonSettings,
         track_energy: bool,
         band_m: f64,
@@ -1370,7 +1386,7 @@ impl NodalContact {
                     self.node_free_steps_m[node] + self.node_corrections_m[node];
             }
             if self.tracked_count > 0 {
-                let (updates, done) = self.newton(settings);
+                let (updates, done) = self.newton(simd, settings);
                 iterations += updates;
                 converged &= done;
             }
@@ -1520,6 +1536,26 @@ impl NodalContact {
             }
             self.set_changed = true;
         }
+    }
+}
+
+/// [`NodalContact::finish_in_lanes`] as an operation for [`Simd::vectorize`]
+/// ([`NodalContact::finish_out_of_line`]).
+struct FinishInLanes<'a, const N: usize, const K: usize, const R: usize> {
+    contact: &'a NodalContact,
+    factors: &'a [[f64; N]; N],
+    delta: &'a mut [f64; N],
+    k: usize,
+    tolerance_m: f64,
+}
+
+impl<const N: usize, const K: usize, const R: usize> WithSimd for FinishInLanes<'_, N, K, R> {
+    type Output = bool;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> bool {
+        self.contact
+            .finish_in_lanes::<N, K, R>(self.factors, self.delta, self.k, self.tolerance_m)
     }
 }
 
